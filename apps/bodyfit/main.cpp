@@ -1,0 +1,79 @@
+// bodyfit: body-fitted tracking of a region moving inside a fixed surface.
+#include "commands.hpp"
+
+#include <bodyfit/config.hpp>
+#include <bodyfit/error.hpp>
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+namespace bodyfit::cli {
+namespace {
+
+std::vector<std::pair<int, CommandSetup>>& registry() {
+  static std::vector<std::pair<int, CommandSetup>> commands;
+  return commands;
+}
+
+}  // namespace
+
+CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
+  registry().emplace_back(order, std::move(setup));
+}
+
+}  // namespace bodyfit::cli
+
+int main(int argc, char** argv) {
+  using namespace bodyfit;
+  CLI::App app{
+      "bodyfit — track a region G(t) moving inside a fixed triangulated surface S, keeping G and\n"
+      "S\\G exactly meshed at every step (level set + body-fitted remeshing).\n\n"
+      "Every stage is also a subcommand that reads and writes Medit .mesh/.sol files, so it can\n"
+      "replace mmgs, mshdist or advect one stage at a time. Start with `bodyfit run case.toml`\n"
+      "(see meshes/ for example cases) or `bodyfit mesh sphere --faces 20000 -o s.mesh`.",
+      "bodyfit"};
+  app.set_version_flag("--version", std::string("bodyfit ") + config::version);
+  app.require_subcommand(1);
+  int verbosity = 0;
+  app.add_flag("-v,--verbose", verbosity, "more log output (-vv for debug traces)");
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "only errors");
+
+  auto& commands = cli::registry();
+  std::stable_sort(commands.begin(), commands.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<cli::Command> added;
+  for (auto& [order, setup] : commands) added.push_back(setup(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  auto logger = spdlog::stderr_color_mt("bodyfit");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("[%T.%e] %^%l%$ %v");
+  spdlog::set_level(quiet ? spdlog::level::err
+                          : verbosity >= 2 ? spdlog::level::trace
+                          : verbosity == 1 ? spdlog::level::debug
+                                           : spdlog::level::info);
+
+  try {
+    for (auto& command : added)
+      if (command.app->parsed()) return command.run();
+    spdlog::error("no subcommand given (see --help)");
+    return 2;
+  } catch (const InputError& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    spdlog::error("internal error: {}", e.what());
+    return 3;
+  }
+}

@@ -1,0 +1,40 @@
+# Third-party dependencies, all Debian 12 packages (see scripts/setup.sh).
+find_package(OpenMesh CONFIG REQUIRED)   # Debian's config has no version file: ask for none
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(fmt REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(TBB REQUIRED)
+find_package(tomlplusplus REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(PNG REQUIRED)
+find_package(Threads REQUIRED)
+
+# CHOLMOD has no CMake config in Debian 12.
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+add_library(bodyfit::cholmod INTERFACE IMPORTED)
+target_include_directories(bodyfit::cholmod INTERFACE ${CHOLMOD_INCLUDE_DIR})
+target_link_libraries(bodyfit::cholmod INTERFACE ${CHOLMOD_LIBRARY})
+
+# TetGen 1.5 (AGPL): only the thermal plugin links it.
+find_path(TETGEN_INCLUDE_DIR tetgen.h)
+find_library(TETGEN_LIBRARY tet)
+if(TETGEN_INCLUDE_DIR AND TETGEN_LIBRARY)
+  add_library(bodyfit::tetgen INTERFACE IMPORTED)
+  target_include_directories(bodyfit::tetgen INTERFACE ${TETGEN_INCLUDE_DIR})
+  target_link_libraries(bodyfit::tetgen INTERFACE ${TETGEN_LIBRARY})
+  target_compile_definitions(bodyfit::tetgen INTERFACE TETLIBRARY)
+endif()
+
+# GDAL is optional: GeoTIFF DEMs are read through it when present.
+set(BODYFIT_HAVE_GDAL OFF)
+if(BODYFIT_WITH_GDAL)
+  find_package(GDAL CONFIG QUIET)
+  if(NOT GDAL_FOUND)
+    find_package(GDAL QUIET)
+  endif()
+  if(GDAL_FOUND)
+    set(BODYFIT_HAVE_GDAL ON)
+  endif()
+endif()
+message(STATUS "bodyfit: GeoTIFF support through GDAL: ${BODYFIT_HAVE_GDAL}")

@@ -1,0 +1,12 @@
+include(CMakePackageConfigHelpers)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/core/include/bodyfit DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${PROJECT_BINARY_DIR}/core/include/bodyfit/config.hpp
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodyfit)
+install(EXPORT bodyfitTargets NAMESPACE bodyfit:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bodyfit)
+configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/bodyfitConfig.cmake.in
+  ${PROJECT_BINARY_DIR}/bodyfitConfig.cmake INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bodyfit)
+write_basic_package_version_file(${PROJECT_BINARY_DIR}/bodyfitConfigVersion.cmake
+  COMPATIBILITY SameMinorVersion)
+install(FILES ${PROJECT_BINARY_DIR}/bodyfitConfig.cmake ${PROJECT_BINARY_DIR}/bodyfitConfigVersion.cmake
+        ${PROJECT_SOURCE_DIR}/cmake/BodyfitPlugin.cmake
+        DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bodyfit)

@@ -1,0 +1,14 @@
+#pragma once
+// Write-then-rename: the target file either keeps its old content or gets the complete new one.
+#include <filesystem>
+#include <fstream>
+#include <functional>
+
+namespace bodyfit {
+
+/// Call `write` on a stream opened on a temporary file next to `target` (binary mode), then flush,
+/// check the stream and rename it over `target`. On any failure the temporary is removed and an
+/// InputError naming `target` is thrown; `target` is never left half-written.
+void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write);
+
+}  // namespace bodyfit

@@ -1,0 +1,301 @@
+#include <bodyfit/geometry.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+namespace bodyfit {
+
+std::array<Vec3, 3> face_points(const SurfaceMesh& mesh, FaceHandle f) {
+  auto h = mesh.halfedge_handle(f);
+  return {mesh.point(mesh.from_vertex_handle(h)), mesh.point(mesh.to_vertex_handle(h)),
+          mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)))};
+}
+
+std::array<VertexHandle, 3> face_vertices(const SurfaceMesh& mesh, FaceHandle f) {
+  auto h = mesh.halfedge_handle(f);
+  return {mesh.from_vertex_handle(h), mesh.to_vertex_handle(h),
+          mesh.to_vertex_handle(mesh.next_halfedge_handle(h))};
+}
+
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return 0.5 * OpenMesh::cross(b - a, c - a).norm();
+}
+
+double face_area(const SurfaceMesh& mesh, FaceHandle f) {
+  auto [a, b, c] = face_points(mesh, f);
+  return triangle_area(a, b, c);
+}
+
+Vec3 face_normal(const SurfaceMesh& mesh, FaceHandle f) {
+  auto [a, b, c] = face_points(mesh, f);
+  Vec3 n = OpenMesh::cross(b - a, c - a);
+  double len = n.norm();
+  return len > 0 ? n / len : Vec3(0, 0, 0);
+}
+
+Vec3 vertex_normal(const SurfaceMesh& mesh, VertexHandle v) {
+  Vec3 sum(0, 0, 0);
+  for (auto f : mesh.vf_range(v)) {
+    auto [a, b, c] = face_points(mesh, f);
+    sum += OpenMesh::cross(b - a, c - a);  // |cross| = 2·area: area weighting for free
+  }
+  double len = sum.norm();
+  return len > 0 ? sum / len : sum;
+}
+
+double edge_length(const SurfaceMesh& mesh, EdgeHandle e) {
+  auto h = mesh.halfedge_handle(e, 0);
+  return (mesh.point(mesh.to_vertex_handle(h)) - mesh.point(mesh.from_vertex_handle(h))).norm();
+}
+
+double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {
+  double l2 = (b - a).sqrnorm() + (c - b).sqrnorm() + (a - c).sqrnorm();
+  if (l2 <= 0) return 0;
+  return 4.0 * std::sqrt(3.0) * triangle_area(a, b, c) / l2;
+}
+
+double face_quality(const SurfaceMesh& mesh, FaceHandle f) {
+  auto [a, b, c] = face_points(mesh, f);
+  return triangle_quality(a, b, c);
+}
+
+std::array<Vec3, 3> p1_basis_gradients(const Vec3& a, const Vec3& b, const Vec3& c) {
+  // grad λ_i = (n × e_i) / (2·area), e_i the edge opposite vertex i, oriented along the face.
+  Vec3 n = OpenMesh::cross(b - a, c - a);
+  double twice_area_sq = n.sqrnorm();
+  if (twice_area_sq <= 0) return {Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 0, 0)};
+  return {OpenMesh::cross(n, c - b) / twice_area_sq, OpenMesh::cross(n, a - c) / twice_area_sq,
+          OpenMesh::cross(n, b - a) / twice_area_sq};
+}
+
+Vec3 face_gradient(const SurfaceMesh& mesh, FaceHandle f, const ScalarField& u) {
+  auto [a, b, c] = face_points(mesh, f);
+  auto [va, vb, vc] = face_vertices(mesh, f);
+  auto g = p1_basis_gradients(a, b, c);
+  return u[va.idx()] * g[0] + u[vb.idx()] * g[1] + u[vc.idx()] * g[2];
+}
+
+VectorField face_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
+  VectorField grads(mesh.n_faces(), Vec3(0, 0, 0));
+  for (auto f : mesh.faces()) grads[f.idx()] = face_gradient(mesh, f, u);
+  return grads;
+}
+
+VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
+  VectorField fg = face_gradients(mesh, u);
+  VectorField result(mesh.n_vertices(), Vec3(0, 0, 0));
+  for (auto v : mesh.vertices()) {
+    Vec3 sum(0, 0, 0);
+    double weight = 0;
+    for (auto f : mesh.vf_range(v)) {
+      double area = face_area(mesh, f);
+      sum += area * fg[f.idx()];
+      weight += area;
+    }
+    if (weight > 0) result[v.idx()] = project_tangent(sum / weight, vertex_normal(mesh, v));
+  }
+  return result;
+}
+
+Vec3 project_tangent(const Vec3& v, const Vec3& unit_normal) {
+  return v - OpenMesh::dot(v, unit_normal) * unit_normal;
+}
+
+std::array<double, 3> barycentric(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  Vec3 n = OpenMesh::cross(b - a, c - a);
+  double d = n.sqrnorm();
+  if (d <= 0) return {1.0 / 3, 1.0 / 3, 1.0 / 3};
+  double la = OpenMesh::dot(OpenMesh::cross(c - b, p - b), n) / d;
+  double lb = OpenMesh::dot(OpenMesh::cross(a - c, p - c), n) / d;
+  return {la, lb, 1.0 - la - lb};
+}
+
+BoundingBox bounding_box(const SurfaceMesh& mesh) {
+  BoundingBox box;
+  bool first = true;
+  for (auto v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    if (first) {
+      box.min = box.max = p;
+      first = false;
+    } else {
+      box.min.minimize(p);
+      box.max.maximize(p);
+    }
+  }
+  return box;
+}
+
+QualityStats quality_stats(const SurfaceMesh& mesh) {
+  QualityStats s;
+  s.min = std::numeric_limits<double>::infinity();
+  double sum = 0;
+  std::size_t below = 0;
+  for (auto f : mesh.faces()) {
+    double q = face_quality(mesh, f);
+    s.min = std::min(s.min, q);
+    s.max = std::max(s.max, q);
+    sum += q;
+    below += q < 0.3;
+    ++s.faces;
+  }
+  if (s.faces == 0) return QualityStats{};
+  s.mean = sum / double(s.faces);
+  s.share_below_0_3 = double(below) / double(s.faces);
+  return s;
+}
+
+EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
+  EdgeLengthStats s;
+  s.min = std::numeric_limits<double>::infinity();
+  double sum = 0, sum_sq = 0;
+  for (auto e : mesh.edges()) {
+    double l = edge_length(mesh, e);
+    s.min = std::min(s.min, l);
+    s.max = std::max(s.max, l);
+    sum += l;
+    sum_sq += l * l;
+    ++s.edges;
+  }
+  if (s.edges == 0) return EdgeLengthStats{};
+  s.mean = sum / double(s.edges);
+  s.stddev = std::sqrt(std::max(0.0, sum_sq / double(s.edges) - s.mean * s.mean));
+  return s;
+}
+
+double total_area(const SurfaceMesh& mesh) {
+  double area = 0;
+  for (auto f : mesh.faces()) area += face_area(mesh, f);
+  return area;
+}
+
+double region_area(const SurfaceMesh& mesh, int region) {
+  double area = 0;
+  for (auto f : mesh.faces())
+    if (mesh.region(f) == region) area += face_area(mesh, f);
+  return area;
+}
+
+double interface_length(const SurfaceMesh& mesh) {
+  double length = 0;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e)) length += edge_length(mesh, e);
+  return length;
+}
+
+long euler_characteristic(const SurfaceMesh& mesh) {
+  auto count = [](auto range) {
+    long n = 0;
+    for ([[maybe_unused]] auto x : range) ++n;
+    return n;
+  };
+  return count(mesh.vertices()) - count(mesh.edges()) + count(mesh.faces());
+}
+
+namespace {
+
+// Flood fill over faces adjacent through edges, restricted to faces accepted by `keep`.
+template <class Keep>
+int flood_components(const SurfaceMesh& mesh, Keep keep, std::vector<int>* labels) {
+  std::vector<int> label(mesh.n_faces(), -1);
+  int n = 0;
+  std::vector<FaceHandle> stack;
+  for (auto seed : mesh.faces()) {
+    if (label[seed.idx()] >= 0 || !keep(seed)) continue;
+    label[seed.idx()] = n;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      auto f = stack.back();
+      stack.pop_back();
+      for (auto g : mesh.ff_range(f))
+        if (label[g.idx()] < 0 && keep(g)) {
+          label[g.idx()] = n;
+          stack.push_back(g);
+        }
+    }
+    ++n;
+  }
+  if (labels) *labels = std::move(label);
+  return n;
+}
+
+}  // namespace
+
+int connected_components(const SurfaceMesh& mesh, std::vector<int>* labels) {
+  return flood_components(mesh, [](FaceHandle) { return true; }, labels);
+}
+
+int region_components(const SurfaceMesh& mesh, int region) {
+  return flood_components(mesh, [&](FaceHandle f) { return mesh.region(f) == region; }, nullptr);
+}
+
+std::vector<std::vector<VertexHandle>> boundary_loops(const SurfaceMesh& mesh) {
+  std::vector<std::vector<VertexHandle>> loops;
+  std::vector<char> visited(mesh.n_halfedges(), 0);
+  for (auto h : mesh.halfedges()) {
+    if (!mesh.is_boundary(h) || visited[h.idx()]) continue;
+    std::vector<VertexHandle> loop;
+    auto cur = h;
+    do {
+      visited[cur.idx()] = 1;
+      loop.push_back(mesh.from_vertex_handle(cur));
+      cur = mesh.next_halfedge_handle(cur);
+    } while (cur != h && !visited[cur.idx()]);
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+InterfaceCurves interface_curves(const SurfaceMesh& mesh) {
+  // Walk the interface graph: vertices of interface-degree ≠ 2 or on the boundary end open curves.
+  std::vector<int> degree(mesh.n_vertices(), 0);
+  for (auto e : mesh.edges())
+    if (mesh.interface(e)) {
+      auto h = mesh.halfedge_handle(e, 0);
+      ++degree[mesh.from_vertex_handle(h).idx()];
+      ++degree[mesh.to_vertex_handle(h).idx()];
+    }
+  std::vector<char> seen(mesh.n_edges(), 0);
+  InterfaceCurves curves;
+  auto is_end = [&](VertexHandle v) { return degree[v.idx()] != 2; };
+  auto walk = [&](VertexHandle start, EdgeHandle first) {
+    auto v = start;
+    auto e = first;
+    while (true) {
+      seen[e.idx()] = 1;
+      auto h = mesh.halfedge_handle(e, 0);
+      v = mesh.from_vertex_handle(h) == v ? mesh.to_vertex_handle(h) : mesh.from_vertex_handle(h);
+      if (is_end(v) || v == start) return;
+      EdgeHandle next;
+      for (auto vh : mesh.voh_range(v)) {
+        auto ne = mesh.edge_handle(vh);
+        if (mesh.interface(ne) && !seen[ne.idx()]) {
+          next = ne;
+          break;
+        }
+      }
+      if (!next.is_valid()) return;
+      e = next;
+    }
+  };
+  for (auto v : mesh.vertices()) {
+    if (!is_end(v) || degree[v.idx()] == 0) continue;
+    for (auto vh : mesh.voh_range(v)) {
+      auto e = mesh.edge_handle(vh);
+      if (mesh.interface(e) && !seen[e.idx()]) {
+        walk(v, e);
+        ++curves.open;
+      }
+    }
+  }
+  for (auto e : mesh.edges())
+    if (mesh.interface(e) && !seen[e.idx()]) {
+      walk(mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)), e);
+      ++curves.closed;
+    }
+  return curves;
+}
+
+}  // namespace bodyfit

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Install the Debian 12 packages bodyfit needs to build, test and run its examples.
+# Idempotent: packages already present are skipped; apt is only called when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  libopenmesh-dev libeigen3-dev libsuitesparse-dev libtet1.5-dev
+  libfmt-dev libspdlog-dev doctest-dev libtomlplusplus-dev libcli11-dev libtbb-dev
+  libpng-dev libgdal-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if ((${#missing[@]})); then
+  SUDO=""
+  [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  echo "setup: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "setup: all build dependencies present"
+fi

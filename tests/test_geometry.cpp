@@ -1,0 +1,59 @@
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+using namespace bodyfit;
+
+TEST_CASE("triangle quality is 1 for an equilateral triangle and 0 for a degenerate one") {
+  Vec3 a(0, 0, 0), b(1, 0, 0), c(0.5, std::sqrt(3.0) / 2, 0);
+  CHECK(triangle_quality(a, b, c) == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK(triangle_quality(a, b, Vec3(2, 0, 0)) == doctest::Approx(0.0));
+  // Right isosceles: area 1/2, Σl² = 1 + 1 + 2 → q = 4√3·0.5/4 = √3/2.
+  CHECK(triangle_quality(a, b, Vec3(0, 1, 0)) == doctest::Approx(std::sqrt(3.0) / 2));
+}
+
+TEST_CASE("P1 gradients reproduce an affine function exactly") {
+  Vec3 a(0.1, 0.2, 0.3), b(1.3, -0.2, 0.5), c(0.4, 0.9, -0.1);
+  Vec3 g(0.7, -1.1, 2.0);
+  auto grads = p1_basis_gradients(a, b, c);
+  Vec3 n = OpenMesh::cross(b - a, c - a).normalized();
+  Vec3 reconstructed = OpenMesh::dot(g, a) * grads[0] + OpenMesh::dot(g, b) * grads[1] + OpenMesh::dot(g, c) * grads[2];
+  Vec3 expected = project_tangent(g, n);
+  CHECK((reconstructed - expected).norm() == doctest::Approx(0.0).epsilon(1e-12));
+}
+
+TEST_CASE("geodesic sphere: face count, radius, quality, topology") {
+  for (std::size_t target : {320u, 2420u, 9680u}) {
+    SphereOptions options;
+    options.faces = target;
+    options.radius = 2.5;
+    SurfaceMesh mesh = make_sphere(options);
+    CHECK(std::abs(double(mesh.n_faces()) - double(target)) <= 0.1 * double(target));
+    for (auto v : mesh.vertices()) CHECK(mesh.point(v).norm() == doctest::Approx(2.5).epsilon(1e-12));
+    CHECK(quality_stats(mesh).min >= 0.7);
+    CHECK(euler_characteristic(mesh) == 2);
+    CHECK(connected_components(mesh) == 1);
+    CHECK(boundary_loops(mesh).empty());
+    // Outward orientation: every face normal points away from the centre.
+    for (auto f : mesh.faces()) {
+      auto p = face_points(mesh, f);
+      CHECK(OpenMesh::dot(face_normal(mesh, f), p[0] + p[1] + p[2]) > 0);
+    }
+  }
+}
+
+TEST_CASE("area of the inscribed geodesic sphere converges at order 2") {
+  // The polyhedron's area deficit is O(h²): quadrupling the faces (h/2) divides it by about 4.
+  double previous = 0;
+  for (std::size_t k : {8u, 16u, 32u}) {
+    SphereOptions options;
+    options.faces = 20 * k * k;
+    double deficit = 4 * M_PI - total_area(make_sphere(options));
+    CHECK(deficit > 0);
+    if (previous > 0) CHECK(std::log2(previous / deficit) == doctest::Approx(2.0).epsilon(0.05));
+    previous = deficit;
+  }
+}
