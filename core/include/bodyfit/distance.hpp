@@ -1,0 +1,30 @@
+#pragma once
+// Signed geodesic distance on a triangulated surface (step 2 of Algorithm 1, paper §3.2).
+#include <bodyfit/mesh.hpp>
+
+#include <limits>
+
+namespace bodyfit {
+
+struct DistanceOptions {
+  /// Stop marching beyond this |d| (narrow band); vertices beyond keep ±infinity.
+  double narrow_band = std::numeric_limits<double>::infinity();
+};
+
+struct DistanceReport {
+  std::size_t initialised = 0;  ///< vertices given an exact value near the interface
+  std::size_t marched = 0;      ///< vertices accepted by fast marching
+  bool has_interface = true;    ///< false when φ does not change sign (result is all ±infinity)
+};
+
+/// Signed geodesic distance to the zero level set of the P1 function φ (any scale; negative inside).
+/// When φ has no zero crossing, every vertex gets +infinity (φ > 0 everywhere) or −infinity.
+ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi,
+                            const DistanceOptions& options = {}, DistanceReport* report = nullptr);
+
+/// Signed geodesic distance to the region made of the faces labelled kInside (f:region): the
+/// interface is the set of e:interface edges; inside vertices get negative values.
+ScalarField signed_distance_to_region(const SurfaceMesh& mesh, const DistanceOptions& options = {},
+                                      DistanceReport* report = nullptr);
+
+}  // namespace bodyfit
