@@ -1,0 +1,54 @@
+#pragma once
+// Finding and loading velocity-model plugins (shared objects named bodyfit_<model>.so).
+//
+// Search order: the directories of BODYFIT_PLUGIN_PATH (colon-separated), the build tree's plugin
+// directory, the install prefix's plugin directory. Every failure (no such model, dlopen error,
+// missing symbol, ABI mismatch, throwing constructor) is an InputError naming the file and reason.
+#include <bodyfit/velocity_model.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace bodyfit {
+
+struct PluginInfo {
+  std::filesystem::path file;
+  std::uint32_t abi = 0;
+  std::string name, version, description;
+  std::vector<ParameterInfo> parameters;
+};
+
+/// A model created by a plugin, keeping the shared object loaded while the model lives.
+class LoadedModel {
+ public:
+  LoadedModel() = default;
+  LoadedModel(LoadedModel&&) noexcept;
+  LoadedModel& operator=(LoadedModel&&) noexcept;
+  ~LoadedModel();
+  VelocityModel& model() const { return *model_; }
+  VelocityModel* operator->() const { return model_; }
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  friend LoadedModel load_plugin_file(const std::filesystem::path& file);
+  void reset();
+  void* handle_ = nullptr;
+  VelocityModel* model_ = nullptr;
+  void (*destroy_)(VelocityModel*) = nullptr;
+  std::filesystem::path file_;
+};
+
+/// Directories searched, in order.
+std::vector<std::filesystem::path> plugin_search_path();
+/// Every plugin found on the search path (the first of each name wins), with its description.
+/// Files that fail to load are reported in `failures` (one message each) instead of throwing.
+std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures = nullptr);
+/// Load the model `name` (bodyfit_<name>.so on the search path), or a plugin file when `name`
+/// contains a '/' or ends in .so.
+LoadedModel load_model(std::string_view name);
+LoadedModel load_plugin_file(const std::filesystem::path& file);
+
+}  // namespace bodyfit

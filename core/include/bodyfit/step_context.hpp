@@ -1,0 +1,21 @@
+#pragma once
+// Building the StepContext handed to VelocityModel::compute (the driver's side of the interface).
+#include <bodyfit/velocity_model.hpp>
+
+#include <filesystem>
+
+namespace bodyfit {
+
+struct StepState {
+  const SurfaceMesh* mesh = nullptr;      ///< T^n (garbage-collected)
+  const ScalarField* distance = nullptr;  ///< d_{G^n} at the vertices
+  double time = 0, dt = 0;
+  int iteration = 0;
+  std::filesystem::path output_dir;
+  bool terrain = false;                   ///< S is a height field z(x, y)
+};
+
+/// The context for one iteration; `state`'s pointers must outlive it.
+StepContext make_step_context(const StepState& state);
+
+}  // namespace bodyfit
