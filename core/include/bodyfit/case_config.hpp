@@ -1,0 +1,105 @@
+#pragma once
+// A run case: the TOML file read by `bodyfit run` (reference: docs/running.md).
+//
+//   [surface]    file = "s.mesh"  |  generator = "sphere" (faces|h, radius) | "terrain" (extent, h,
+//                seed, dem, max_height, feature_size) | "plane" (size, h)
+//   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
+//                degrees, center) | "disks" (centers = [[x, y], ...], radii = [...])
+//   [model]      name = "conormal", every other key is the model's own parameter
+//   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations
+//   [distance] [advection] [discretize] [remesh]   options of each stage
+//   [output]     vtu_every, png_every, field, view, size = [w, h]
+//
+// Every table and key is checked: an unknown one is an InputError with a suggestion ("unknown key
+// 'tiem' in [time]; did you mean 'time'?"), as is a wrong type or a missing required key.
+#include <bodyfit/advection.hpp>
+#include <bodyfit/distance.hpp>
+#include <bodyfit/generators.hpp>
+#include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/mesh.hpp>
+#include <bodyfit/remesh.hpp>
+
+#include <toml++/toml.h>
+
+#include <array>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace bodyfit {
+
+struct SurfaceSpec {
+  enum class Kind { File, Sphere, Terrain, Plane };
+  Kind kind = Kind::Sphere;
+  std::filesystem::path file;       ///< Kind::File (relative paths are relative to the case file)
+  SphereOptions sphere;             ///< Kind::Sphere
+  TerrainOptions terrain;           ///< Kind::Terrain (procedural, or from `dem`)
+  std::filesystem::path dem;        ///< Kind::Terrain: a DEM raster instead of the procedural landscape
+  double plane_size = 2;            ///< Kind::Plane: side of the square [-size/2, size/2]², z = 0
+  double plane_h = 0.05;            ///< Kind::Plane: edge length
+};
+
+struct RegionSpec {
+  enum class Kind { Refs, Sol, Cap, Disks };
+  Kind kind = Kind::Cap;
+  std::vector<int> refs{kInside};   ///< Kind::Refs: face refs of the file that make up G
+  std::filesystem::path sol;        ///< Kind::Sol: φ at the vertices of the surface (< 0 inside)
+  Vec3 axis{0, 0, 1};               ///< Kind::Cap: unit axis of the cap
+  double angle = 45;                ///< Kind::Cap: polar angle, degrees
+  Vec3 center{0, 0, 0};             ///< Kind::Cap: centre of the sphere
+  std::vector<std::array<double, 3>> disks;  ///< Kind::Disks: (x, y, radius), horizontal distance
+};
+
+struct TimeSpec {
+  double dt = 0;   ///< fixed time step (0: use cfl)
+  double cfl = 0;  ///< Δt = cfl·h, h = remesh.hmax when given, else the mean edge length of T^0
+  double final_time = std::numeric_limits<double>::infinity();
+  long iterations = -1;  ///< −1: no limit (final_time decides)
+};
+
+struct OutputSpec {
+  int vtu_every = 1;              ///< 0: no VTU series
+  int png_every = 0;              ///< 0: no PNG snapshots
+  std::string field = "region";   ///< region | phi | d | quality | height | a model's point field
+  std::string view = "iso";       ///< iso | top | front
+  int width = 800, height = 600;
+};
+
+struct CaseConfig {
+  std::filesystem::path file;      ///< the case file ("" when parsed from a string)
+  std::filesystem::path base_dir;  ///< relative paths in the case are relative to this
+  SurfaceSpec surface;
+  RegionSpec region;
+  std::string model;               ///< plugin name
+  toml::table model_parameters;    ///< [model] without `name`
+  TimeSpec time;
+  DistanceOptions distance;
+  AdvectionOptions advection;
+  DiscretizeOptions discretize;
+  RemeshOptions remesh;            ///< `reference` is left empty: the driver sets it
+  OutputSpec output;
+  toml::table effective;           ///< the whole table after overrides (written as outdir/case.toml)
+};
+
+/// Apply one "dotted.key=value" override to a table. The value is parsed as a TOML value
+/// (0.05, 12, true, "text", [1, 2]); anything that does not parse is taken as a string.
+void apply_override(toml::table& table, const std::string& assignment);
+
+/// Validate a case table and turn it into a CaseConfig (throws InputError).
+CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir = {});
+/// Read a case file, apply the overrides in order, validate.
+CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+
+/// The closest word of `candidates` to `word` (edit distance ≤ max(2, |word|/3)), or "".
+std::string closest_word(const std::string& word, const std::vector<std::string>& candidates);
+
+/// The surface S of the case (generated or read), without region labels.
+SurfaceMesh make_case_surface(const CaseConfig& config);
+/// The initial level set of the case on the vertices of `surface` (negative inside G(0)), or an
+/// empty field when the region comes from face refs (RegionSpec::Kind::Refs).
+ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surface);
+/// Label `surface`'s faces from its refs (RegionSpec::Kind::Refs): refs listed are G.
+void label_from_refs(const CaseConfig& config, SurfaceMesh& surface);
+
+}  // namespace bodyfit
