@@ -4,6 +4,8 @@
 // Search order: the directories of BODYFIT_PLUGIN_PATH (colon-separated), the build tree's plugin
 // directory, the install prefix's plugin directory. Every failure (no such model, dlopen error,
 // missing symbol, ABI mismatch, throwing constructor) is an InputError naming the file and reason.
+// The ABI (major << 16 | minor) is checked before anything else: the major must equal ours and the
+// plugin's minor must not exceed ours (a plugin built against older headers of the same major loads).
 #include <bodyfit/velocity_model.hpp>
 
 #include <cstdint>
@@ -31,14 +33,22 @@ class LoadedModel {
   VelocityModel& model() const { return *model_; }
   VelocityModel* operator->() const { return model_; }
   const std::filesystem::path& file() const { return file_; }
+  /// The ABI the plugin reported (kPluginAbi of the headers it was built with).
+  std::uint32_t abi() const { return abi_; }
 
  private:
   friend LoadedModel load_plugin_file(const std::filesystem::path& file);
+/// Call model.configure(parameters); any exception becomes InputError
+/// "<file>: configure failed: <reason>".
+void configure_model(LoadedModel& model, const toml::table& parameters);
+/// Decode kPluginAbi-style numbers: "1.0".
+std::string abi_string(std::uint32_t abi);
   void reset();
   void* handle_ = nullptr;
   VelocityModel* model_ = nullptr;
   void (*destroy_)(VelocityModel*) = nullptr;
   std::filesystem::path file_;
+  std::uint32_t abi_ = 0;
 };
 
 /// Directories searched, in order.
@@ -50,5 +60,10 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures = nu
 /// contains a '/' or ends in .so.
 LoadedModel load_model(std::string_view name);
 LoadedModel load_plugin_file(const std::filesystem::path& file);
+/// Call model.configure(parameters); any exception becomes InputError
+/// "<file>: configure failed: <reason>".
+void configure_model(LoadedModel& model, const toml::table& parameters);
+/// Decode kPluginAbi-style numbers: "1.0".
+std::string abi_string(std::uint32_t abi);
 
 }  // namespace bodyfit

@@ -1,0 +1,230 @@
+// Finding plugins on the search path, dlopen-ing them, checking their ABI and creating models.
+#include <bodyfit/plugin_loader.hpp>
+
+#include <bodyfit/config.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/parameters.hpp>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <exception>
+#include <map>
+#include <set>
+#include <system_error>
+
+namespace fs = std::filesystem;
+
+namespace bodyfit {
+
+namespace {
+
+constexpr std::string_view kPrefix = "bodyfit_";
+constexpr std::string_view kSuffix = ".so";
+
+using AbiFunction = std::uint32_t (*)();
+using CreateFunction = VelocityModel* (*)();
+using DestroyFunction = void (*)(VelocityModel*);
+
+std::string dl_error() {
+  const char* message = dlerror();
+  return message ? message : "unknown dynamic-loader error";
+}
+
+/// Closes a dlopen handle unless released (for the failure paths of load_plugin_file).
+struct HandleGuard {
+  void* handle = nullptr;
+  ~HandleGuard() {
+    if (handle) dlclose(handle);
+  }
+  void* release() { return std::exchange(handle, nullptr); }
+};
+
+void* require_symbol(void* handle, const fs::path& file, const char* symbol) {
+  dlerror();
+  void* address = dlsym(handle, symbol);
+  if (!address)
+    throw file_error(file, fmt::format("not a bodyfit plugin: missing symbol '{}' (build it with BODYFIT_PLUGIN(YourModel))",
+                                       symbol));
+  return address;
+}
+
+/// The model name of a file called bodyfit_<name>.so, or "" for any other file.
+std::string model_name_of(const fs::path& file) {
+  std::string base = file.filename().string();
+  if (base.size() <= kPrefix.size() + kSuffix.size() || !base.starts_with(kPrefix) || !base.ends_with(kSuffix))
+    return {};
+  return base.substr(kPrefix.size(), base.size() - kPrefix.size() - kSuffix.size());
+}
+
+/// Plugin files of a directory, sorted by name (missing or unreadable directories give none).
+std::vector<fs::path> plugin_files(const fs::path& dir) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return files;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (!model_name_of(it->path()).empty() && it->is_regular_file(ec)) files.push_back(it->path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace
+
+std::string abi_string(std::uint32_t abi) { return fmt::format("{}.{}", abi >> 16, abi & 0xffffu); }
+
+// ---- LoadedModel ---------------------------------------------------------------------------------
+
+LoadedModel::LoadedModel(LoadedModel&& other) noexcept
+    : handle_(std::exchange(other.handle_, nullptr)),
+      model_(std::exchange(other.model_, nullptr)),
+      destroy_(std::exchange(other.destroy_, nullptr)),
+      file_(std::move(other.file_)),
+      abi_(std::exchange(other.abi_, 0)) {}
+
+LoadedModel& LoadedModel::operator=(LoadedModel&& other) noexcept {
+  if (this != &other) {
+    reset();
+    handle_ = std::exchange(other.handle_, nullptr);
+    model_ = std::exchange(other.model_, nullptr);
+    destroy_ = std::exchange(other.destroy_, nullptr);
+    file_ = std::move(other.file_);
+    abi_ = std::exchange(other.abi_, 0);
+  }
+  return *this;
+}
+
+LoadedModel::~LoadedModel() { reset(); }
+
+void LoadedModel::reset() {
+  // The model's code lives in the shared object: destroy it before closing the handle.
+  if (model_ && destroy_) destroy_(model_);
+  model_ = nullptr;
+  destroy_ = nullptr;
+  if (handle_) dlclose(handle_);
+  handle_ = nullptr;
+}
+
+// ---- search path ---------------------------------------------------------------------------------
+
+std::vector<fs::path> plugin_search_path() {
+  std::vector<fs::path> dirs;
+  auto add = [&](const fs::path& dir) {
+    if (!dir.empty() && std::find(dirs.begin(), dirs.end(), dir) == dirs.end()) dirs.push_back(dir);
+  };
+  if (const char* env = std::getenv("BODYFIT_PLUGIN_PATH")) {
+    std::string_view rest(env);
+    while (true) {
+      auto colon = rest.find(':');
+      add(fs::path(std::string(rest.substr(0, colon))));
+      if (colon == std::string_view::npos) break;
+      rest.remove_prefix(colon + 1);
+    }
+  }
+  add(config::plugin_build_dir);
+  add(config::plugin_install_dir);
+  return dirs;
+}
+
+// ---- loading -------------------------------------------------------------------------------------
+
+LoadedModel load_plugin_file(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw file_error(file, "no such plugin file");
+  dlerror();
+  HandleGuard guard{dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL)};
+  if (!guard.handle) throw file_error(file, "cannot load plugin: " + dl_error());
+
+  // The ABI first: nothing else of a plugin built against other headers may be trusted.
+  auto abi_function = reinterpret_cast<AbiFunction>(require_symbol(guard.handle, file, "bodyfit_plugin_abi"));
+  std::uint32_t abi = abi_function();
+  if ((abi >> 16) != kPluginAbiMajor || (abi & 0xffffu) > kPluginAbiMinor)
+    throw file_error(file, fmt::format("plugin ABI {} is incompatible with this bodyfit (ABI {}): rebuild the plugin "
+                                       "against bodyfit {}",
+                                       abi_string(abi), abi_string(kPluginAbi), config::version));
+  auto create = reinterpret_cast<CreateFunction>(require_symbol(guard.handle, file, "bodyfit_create"));
+  auto destroy = reinterpret_cast<DestroyFunction>(require_symbol(guard.handle, file, "bodyfit_destroy"));
+
+  VelocityModel* model = nullptr;
+  try {
+    model = create();
+  } catch (const std::exception& e) {
+    throw file_error(file, fmt::format("bodyfit_create failed: {}", e.what()));
+  } catch (...) {
+    throw file_error(file, "bodyfit_create failed with an unknown exception");
+  }
+  if (!model) throw file_error(file, "bodyfit_create returned no model");
+
+  LoadedModel loaded;
+  loaded.handle_ = guard.release();
+  loaded.model_ = model;
+  loaded.destroy_ = destroy;
+  loaded.file_ = file;
+  loaded.abi_ = abi;
+  return loaded;
+}
+
+LoadedModel load_model(std::string_view name) {
+  if (name.find('/') != std::string_view::npos || name.ends_with(kSuffix)) return load_plugin_file(fs::path(name));
+  if (name.empty()) throw InputError("no velocity model given (the [model] table needs name = \"...\")");
+  std::string file_name = fmt::format("{}{}{}", kPrefix, name, kSuffix);
+  auto dirs = plugin_search_path();
+  std::error_code ec;
+  for (const auto& dir : dirs)
+    if (fs::exists(dir / file_name, ec)) return load_plugin_file(dir / file_name);
+
+  std::set<std::string> available;
+  for (const auto& dir : dirs)
+    for (const auto& file : plugin_files(dir)) available.insert(model_name_of(file));
+  std::vector<std::string> dir_names;
+  for (const auto& dir : dirs) dir_names.push_back(dir.string());
+  std::string message = fmt::format("unknown velocity model '{}': no {} in {}", name, file_name,
+                                    fmt::join(dir_names, ":"));
+  std::vector<std::string> names(available.begin(), available.end());
+  if (auto near = closest_match(name, names); !near.empty()) message += fmt::format("; did you mean '{}'?", near);
+  message += names.empty() ? std::string("; no plugin found (set BODYFIT_PLUGIN_PATH)")
+                           : fmt::format(" (available: {})", fmt::join(names, ", "));
+  throw InputError(message);
+}
+
+void configure_model(LoadedModel& model, const toml::table& parameters) {
+  try {
+    model->configure(parameters);
+  } catch (const std::exception& e) {
+    throw file_error(model.file(), fmt::format("configure failed: {}", e.what()));
+  } catch (...) {
+    throw file_error(model.file(), "configure failed with an unknown exception");
+  }
+}
+
+std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
+  std::map<std::string, PluginInfo> found;  // by file name: the first directory wins
+  std::set<std::string> seen;
+  for (const auto& dir : plugin_search_path()) {
+    for (const auto& file : plugin_files(dir)) {
+      std::string name = model_name_of(file);
+      if (!seen.insert(name).second) continue;
+      try {
+        LoadedModel loaded = load_plugin_file(file);
+        PluginInfo info;
+        info.file = file;
+        info.abi = loaded.abi();
+        info.name = std::string(loaded->name());
+        info.version = std::string(loaded->version());
+        info.description = std::string(loaded->description());
+        info.parameters = loaded->parameters();
+        found.emplace(name, std::move(info));
+      } catch (const std::exception& e) {
+        if (failures) failures->push_back(e.what());
+      }
+    }
+  }
+  std::vector<PluginInfo> result;
+  for (auto& [name, info] : found) result.push_back(std::move(info));
+  return result;
+}
+
+}  // namespace bodyfit

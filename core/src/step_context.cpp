@@ -1,0 +1,143 @@
+// StepContext: the read-only view a velocity model gets, with helpers computed on first use.
+#include <bodyfit/step_context.hpp>
+
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/surface_fem.hpp>
+
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+
+namespace bodyfit {
+
+struct StepContext::Impl {
+  StepState state;
+  // Caches: filled on first use under the mutex; never modified afterwards, so the references
+  // handed out stay valid for the context's lifetime.
+  mutable std::mutex mutex;
+  mutable std::optional<double> mesh_size;
+  mutable std::optional<std::vector<double>> face_areas;
+  mutable std::optional<VectorField> face_normals, vertex_normals, conormal;
+  mutable std::optional<Eigen::SparseMatrix<double>> mass, stiffness;
+  mutable std::map<double, H1Smoother> smoothers;  // one factorisation per length
+
+  const SurfaceMesh& mesh() const { return *state.mesh; }
+
+  const VectorField& vertex_normals_locked() const {
+    if (!vertex_normals) {
+      VectorField normals(mesh().n_vertices(), Vec3(0, 0, 0));
+      for (auto v : mesh().vertices()) normals[v.idx()] = vertex_normal(mesh(), v);
+      vertex_normals = std::move(normals);
+    }
+    return *vertex_normals;
+  }
+  const Eigen::SparseMatrix<double>& mass_locked() const {
+    if (!mass) mass = bodyfit::mass_matrix(mesh());
+    return *mass;
+  }
+  const Eigen::SparseMatrix<double>& stiffness_locked() const {
+    if (!stiffness) stiffness = bodyfit::stiffness_matrix(mesh());
+    return *stiffness;
+  }
+  const H1Smoother& smoother_locked(double length) const {
+    auto it = smoothers.find(length);
+    if (it == smoothers.end())
+      it = smoothers.emplace(length, H1Smoother(mass_locked(), stiffness_locked(), length, vertex_normals_locked()))
+               .first;
+    return it->second;
+  }
+};
+
+StepContext make_step_context(const StepState& state) {
+  if (!state.mesh || !state.distance) throw std::invalid_argument("make_step_context: mesh and distance are required");
+  if (state.distance->size() != state.mesh->n_vertices())
+    throw std::invalid_argument("make_step_context: the distance has one value per vertex");
+  auto impl = std::make_unique<StepContext::Impl>();
+  impl->state = state;
+  return StepContext(std::move(impl));
+}
+
+StepContext::StepContext(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+StepContext::~StepContext() = default;
+
+const SurfaceMesh& StepContext::mesh() const { return *impl_->state.mesh; }
+const ScalarField& StepContext::distance() const { return *impl_->state.distance; }
+double StepContext::time() const { return impl_->state.time; }
+double StepContext::dt() const { return impl_->state.dt; }
+int StepContext::iteration() const { return impl_->state.iteration; }
+const std::filesystem::path& StepContext::output_dir() const { return impl_->state.output_dir; }
+bool StepContext::is_terrain() const { return impl_->state.terrain; }
+
+double StepContext::mesh_size() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->mesh_size) impl_->mesh_size = edge_length_stats(mesh()).mean;
+  return *impl_->mesh_size;
+}
+
+const std::vector<double>& StepContext::face_areas() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->face_areas) {
+    std::vector<double> areas(mesh().n_faces(), 0.0);
+    for (auto f : mesh().faces()) areas[f.idx()] = face_area(mesh(), f);
+    impl_->face_areas = std::move(areas);
+  }
+  return *impl_->face_areas;
+}
+
+const VectorField& StepContext::face_normals() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->face_normals) {
+    VectorField normals(mesh().n_faces(), Vec3(0, 0, 0));
+    for (auto f : mesh().faces()) normals[f.idx()] = face_normal(mesh(), f);
+    impl_->face_normals = std::move(normals);
+  }
+  return *impl_->face_normals;
+}
+
+const VectorField& StepContext::vertex_normals() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->vertex_normals_locked();
+}
+
+const VectorField& StepContext::conormal() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->conormal) {
+    // Area-weighted face gradients of d, projected on the vertex tangent plane, normalised.
+    // |∇_S d| = 1 away from the cut locus; where the average cancels (ridges of d) n_Σ is 0.
+    VectorField n = bodyfit::vertex_gradients(mesh(), distance());
+    for (auto& g : n) {
+      double length = g.norm();
+      g = length > 1e-12 ? g / length : Vec3(0, 0, 0);
+    }
+    impl_->conormal = std::move(n);
+  }
+  return *impl_->conormal;
+}
+
+VectorField StepContext::face_gradients(const ScalarField& u) const { return bodyfit::face_gradients(mesh(), u); }
+VectorField StepContext::vertex_gradients(const ScalarField& u) const { return bodyfit::vertex_gradients(mesh(), u); }
+
+const Eigen::SparseMatrix<double>& StepContext::mass_matrix() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->mass_locked();
+}
+
+const Eigen::SparseMatrix<double>& StepContext::stiffness_matrix() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->stiffness_locked();
+}
+
+ScalarField StepContext::smooth(const ScalarField& f, double length) const {
+  if (length == 0) return f;
+  std::lock_guard lock(impl_->mutex);  // CHOLMOD's workspace is shared by the solves
+  return impl_->smoother_locked(length).smooth(f);
+}
+
+VectorField StepContext::smooth(const VectorField& f, double length) const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->smoother_locked(length).smooth(f);
+}
+
+}  // namespace bodyfit
