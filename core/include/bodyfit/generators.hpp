@@ -9,12 +9,15 @@
 namespace bodyfit {
 
 struct SphereOptions {
-  std::size_t faces = 20480;  ///< target face count; the result is within ±10 % for faces ≥ 320
+  std::size_t faces = 20480;  ///< target face count (≥ 20); the result is within ±10 %
   double radius = 1.0;
   Vec3 center{0, 0, 0};
 };
-/// Geodesic sphere (subdivided icosahedron, frequency k gives 20k² faces), all vertices exactly on
-/// the sphere, minimum triangle quality ≥ 0.7, outward orientation.
+/// Sphere of about `faces` triangles (within ±10 %), all vertices exactly on the sphere, minimum
+/// triangle quality ≥ 0.7, outward orientation. The closest geodesic count is used: class I
+/// (subdivided icosahedron, frequency k, 20k² faces, exact for 20k²) or Goldberg–Coxeter class II/III
+/// (20(a² + ab + b²) faces); counts with no geodesic sphere within 10 % (some below 300) get a
+/// Delaunay triangulation of N/2 + 2 points spread by Coulomb repulsion.
 SurfaceMesh make_sphere(const SphereOptions& options = {});
 
 /// A raster of heights: rows from north (top) to south, like an ESRI ASCII grid.
