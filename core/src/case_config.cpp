@@ -2,6 +2,7 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
+#include <bodyfit/projection.hpp>
 
 #include <fmt/format.h>
 
@@ -470,6 +471,14 @@ ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surfa
     }
   }
   return phi;
+}
+
+std::shared_ptr<const ReferenceSurface> make_case_reference(const CaseConfig& config, const SurfaceMesh& surface) {
+  if (config.surface.kind == SurfaceSpec::Kind::Sphere)
+    return ReferenceSurface::sphere(config.surface.sphere.center, config.surface.sphere.radius);
+  SurfaceMesh copy = surface;
+  copy.garbage_collection();
+  return std::make_shared<const ReferenceSurface>(copy);
 }
 
 void label_from_refs(const CaseConfig& config, SurfaceMesh& surface) {

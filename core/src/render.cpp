@@ -223,6 +223,26 @@ void set_view(RenderOptions& options, const std::string& view) {
   else throw InputError(fmt::format("unknown view '{}' (iso, top or front)", view));
 }
 
+std::vector<double> named_vertex_field(const SurfaceMesh& mesh, const std::string& name) {
+  std::vector<double> out;
+  if (name == "phi") {
+    out.resize(mesh.n_vertices());
+    for (auto v : mesh.vertices()) out[v.idx()] = mesh.phi(v);
+  } else if (name == "height") {
+    out.resize(mesh.n_vertices());
+    for (auto v : mesh.vertices()) out[v.idx()] = mesh.point(v)[2];
+  } else if (name == "quality") {
+    out.assign(mesh.n_vertices(), 0);
+    std::vector<int> count(mesh.n_vertices(), 0);
+    for (auto f : mesh.faces()) {
+      double q = face_quality(mesh, f);
+      for (auto v : mesh.fv_range(f)) out[v.idx()] += q, ++count[v.idx()];
+    }
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = count[i] ? out[i] / count[i] : 0;
+  }
+  return out;
+}
+
 Image render(const SurfaceMesh& mesh, const RenderOptions& options) {
   if (options.width < 16 || options.height < 16) throw InputError("render: image size must be at least 16×16");
   const bool by_field = !options.field.empty();

@@ -24,6 +24,7 @@
 #include <array>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,9 @@ SurfaceMesh make_case_surface(const CaseConfig& config);
 /// The initial level set of the case on the vertices of `surface` (negative inside G(0)), or an
 /// empty field when the region comes from face refs (RegionSpec::Kind::Refs).
 ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surface);
+/// The fixed reference surface S for the remesher: the exact sphere for a generated sphere, else
+/// the triangles of `surface` (call before any remeshing).
+std::shared_ptr<const ReferenceSurface> make_case_reference(const CaseConfig& config, const SurfaceMesh& surface);
 /// Label `surface`'s faces from its refs (RegionSpec::Kind::Refs): refs listed are G.
 void label_from_refs(const CaseConfig& config, SurfaceMesh& surface);
 

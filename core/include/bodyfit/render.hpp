@@ -60,6 +60,10 @@ struct RenderOptions {
 /// Set azimuth/elevation for a named view: "iso", "top" or "front" (InputError otherwise).
 void set_view(RenderOptions& options, const std::string& view);
 
+/// A vertex field by name: "phi" (v:phi), "quality" (mean quality of the incident faces),
+/// "height" (z); empty for "region" and for an unknown name.
+std::vector<double> named_vertex_field(const SurfaceMesh& mesh, const std::string& name);
+
 Image render(const SurfaceMesh& mesh, const RenderOptions& options = {});
 void render_png(const SurfaceMesh& mesh, const std::filesystem::path& file, const RenderOptions& options = {});
 
