@@ -1,0 +1,134 @@
+#include "fire_maps.hpp"
+
+#include <bodyfit/geometry.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace bodyfit::fire {
+namespace {
+
+// Faces bucketed on a regular grid in plan view, to find the face above a point (x, y) of a
+// terrain (a height field: its projection on the plane is one-to-one).
+class PlanLocator {
+ public:
+  PlanLocator(const SurfaceMesh& mesh, double cell) : mesh_(mesh) {
+    BoundingBox box = bounding_box(mesh);
+    x0_ = box.min[0];
+    y0_ = box.min[1];
+    cell_ = cell > 0 ? cell : 1.0;
+    nx_ = std::max<long>(1, long(std::ceil((box.max[0] - x0_) / cell_)) + 1);
+    ny_ = std::max<long>(1, long(std::ceil((box.max[1] - y0_) / cell_)) + 1);
+    buckets_.assign(std::size_t(nx_ * ny_), {});
+    for (auto f : mesh.faces()) {
+      auto p = face_points(mesh, f);
+      double xmin = std::min({p[0][0], p[1][0], p[2][0]}), xmax = std::max({p[0][0], p[1][0], p[2][0]});
+      double ymin = std::min({p[0][1], p[1][1], p[2][1]}), ymax = std::max({p[0][1], p[1][1], p[2][1]});
+      for (long j = index(ymin, y0_, ny_); j <= index(ymax, y0_, ny_); ++j)
+        for (long i = index(xmin, x0_, nx_); i <= index(xmax, x0_, nx_); ++i)
+          buckets_[std::size_t(j * nx_ + i)].push_back(f);
+    }
+  }
+
+  /// The face above (x, y) and the barycentric coordinates there; invalid face when outside.
+  FaceHandle locate(double x, double y, std::array<double, 3>& bary) const {
+    long i = index(x, x0_, nx_), j = index(y, y0_, ny_);
+    for (FaceHandle f : buckets_[std::size_t(j * nx_ + i)]) {
+      auto p = face_points(mesh_, f);
+      double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+      if (det == 0) continue;
+      double l1 = ((x - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (y - p[0][1])) / det;
+      double l2 = ((p[1][0] - p[0][0]) * (y - p[0][1]) - (x - p[0][0]) * (p[1][1] - p[0][1])) / det;
+      double l0 = 1 - l1 - l2;
+      const double eps = -1e-9;
+      if (l0 >= eps && l1 >= eps && l2 >= eps) {
+        bary = {l0, l1, l2};
+        return f;
+      }
+    }
+    return FaceHandle();
+  }
+
+ private:
+  long index(double v, double origin, long n) const {
+    return std::clamp(long(std::floor((v - origin) / cell_)), 0L, n - 1);
+  }
+  const SurfaceMesh& mesh_;
+  double x0_ = 0, y0_ = 0, cell_ = 1;
+  long nx_ = 1, ny_ = 1;
+  std::vector<std::vector<FaceHandle>> buckets_;
+};
+
+double cell_center_x(const HeightGrid& g, std::size_t col) { return g.x_origin + (double(col) + 0.5) * g.cell_size; }
+double cell_center_y(const HeightGrid& g, std::size_t row) {
+  return g.y_origin + (double(g.rows - 1 - row) + 0.5) * g.cell_size;  // row 0 is the northernmost
+}
+
+}  // namespace
+
+double raster_nearest(const HeightGrid& grid, double x, double y) {
+  if (grid.cols == 0) return std::numeric_limits<double>::quiet_NaN();
+  long col = std::clamp(long(std::floor((x - grid.x_origin) / grid.cell_size)), 0L, long(grid.cols) - 1);
+  long row_from_south = std::clamp(long(std::floor((y - grid.y_origin) / grid.cell_size)), 0L, long(grid.rows) - 1);
+  return grid.at(grid.rows - 1 - std::size_t(row_from_south), std::size_t(col));
+}
+
+Vec3 WindField::at(const Vec3& x) const {
+  if (type == "uniform") return uniform;
+  if (type == "rotating") return scale * Vec3(x[1] - center[1], -(x[0] - center[0]), 0);
+  if (type == "grid") return Vec3(u.sample(x[0], x[1]), v.sample(x[0], x[1]), 0);
+  return Vec3(0, 0, 0);
+}
+
+void ArrivalRaster::initialise(const SurfaceMesh& mesh, double cell_size, const HeightGrid& like, double mesh_size) {
+  if (like.cols > 0) {
+    grid_ = like;
+  } else {
+    BoundingBox box = bounding_box(mesh);
+    grid_ = HeightGrid{};
+    grid_.cell_size = cell_size > 0 ? cell_size : mesh_size;
+    grid_.x_origin = box.min[0];
+    grid_.y_origin = box.min[1];
+    grid_.cols = std::max<std::size_t>(1, std::size_t(std::ceil((box.max[0] - box.min[0]) / grid_.cell_size)));
+    grid_.rows = std::max<std::size_t>(1, std::size_t(std::ceil((box.max[1] - box.min[1]) / grid_.cell_size)));
+  }
+  grid_.nodata = -9999;
+  grid_.heights.assign(grid_.cols * grid_.rows, std::numeric_limits<double>::quiet_NaN());
+}
+
+void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next,
+                           double time, double dt) {
+  PlanLocator locator(mesh, 2 * edge_length_stats(mesh).mean);
+  for (std::size_t row = 0; row < grid_.rows; ++row)
+    for (std::size_t col = 0; col < grid_.cols; ++col) {
+      double& arrival = grid_.heights[row * grid_.cols + col];
+      if (!std::isnan(arrival)) continue;
+      std::array<double, 3> bary;
+      FaceHandle f = locator.locate(cell_center_x(grid_, col), cell_center_y(grid_, row), bary);
+      if (!f.is_valid()) continue;
+      auto vs = face_vertices(mesh, f);
+      double d = 0, phi = 0;
+      for (int k = 0; k < 3; ++k) {
+        d += bary[k] * distance[vs[k].idx()];
+        phi += bary[k] * phi_next[vs[k].idx()];
+      }
+      if (d <= 0) arrival = time;  // already burnt at t^n (the initial region)
+      else if (phi <= 0) arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
+    }
+}
+
+ScalarField ArrivalRaster::sample_at_vertices(const SurfaceMesh& mesh) const {
+  ScalarField values(mesh.n_vertices(), std::numeric_limits<double>::quiet_NaN());
+  for (auto v : mesh.vertices()) values[v.idx()] = raster_nearest(grid_, mesh.point(v)[0], mesh.point(v)[1]);
+  return values;
+}
+
+void ArrivalRaster::write(const std::filesystem::path& file) const {
+  HeightGrid out = grid_;
+  for (double& value : out.heights)
+    if (std::isnan(value)) value = out.nodata;
+  write_esri_ascii(file, out);
+}
+
+}  // namespace bodyfit::fire
