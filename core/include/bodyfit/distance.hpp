@@ -15,6 +15,9 @@ struct DistanceReport {
   std::size_t initialised = 0;  ///< vertices given an exact value near the interface
   std::size_t marched = 0;      ///< vertices accepted by fast marching
   bool has_interface = true;    ///< false when φ does not change sign (result is all ±infinity)
+  double setup_ms = 0;          ///< flat arrays, fans, obtuse-angle unfolding
+  double init_ms = 0;           ///< interface segments (zero set of φ, or interface edges)
+  double march_ms = 0;          ///< exact initialisation near the interface, then fast marching
 };
 
 /// Signed geodesic distance to the zero level set of the P1 function φ (any scale; negative inside).

@@ -1,0 +1,437 @@
+// Signed geodesic distance on a triangulated surface: exact initialisation next to the zero set of
+// the P1 level set, then fast marching (Kimmel–Sethian triangle update, obtuse angles split by
+// unfolding) over flat arrays.
+#include <bodyfit/distance.hpp>
+#include <bodyfit/error.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <queue>
+#include <utility>
+#include <vector>
+
+namespace bodyfit {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Gram data of a corner: the triangle (x; a, b) seen from x, with ea = a − x, eb = b − x.
+struct CornerGeometry {
+  double aa = 0, bb = 0, ab = 0;  ///< |ea|², |eb|², ea·eb
+};
+
+CornerGeometry corner_geometry(const Vec3& ea, const Vec3& eb) { return {ea.sqrnorm(), eb.sqrnorm(), ea | eb}; }
+
+/// Planar-front update of x from the known values da at a and db at b (Kimmel–Sethian): the value
+/// t at x such that the linear interpolant of (t, da, db) has unit gradient and its characteristic
+/// reaches x from inside the angle (a, x, b); +infinity when there is no such t (the caller then
+/// uses the edges). A causal t never exceeds the edge values da + |ea|, db + |eb| (unit gradient).
+double triangle_update(const CornerGeometry& g, double da, double db) {
+  const double det = g.aa * g.bb - g.ab * g.ab;
+  // Q⁻¹ = [[bb, −ab], [−ab, aa]] / det. Solve (1ᵀQ⁻¹1) t² − 2 (1ᵀQ⁻¹D) t + DᵀQ⁻¹D − 1 = 0.
+  const double qa = g.aa + g.bb - 2 * g.ab;  // |a − b|², times 1/det omitted everywhere
+  const double qb = da * (g.bb - g.ab) + db * (g.aa - g.ab);
+  const double qc = da * da * g.bb - 2 * da * db * g.ab + db * db * g.aa - det;
+  const double disc = qb * qb - qa * qc;
+  if (det <= 0 || disc < 0 || qa <= 0) return kInf;
+  const double t = (qb + std::sqrt(disc)) / qa;
+  // Causality: −∇d = α ea + β eb with α, β ≥ 0, i.e. Q⁻¹(D − t·1) ≤ 0.
+  const double ua = da - t, ub = db - t;
+  return g.bb * ua - g.ab * ub <= 0 && g.aa * ub - g.ab * ua <= 0 ? t : kInf;
+}
+
+/// For an obtuse corner: the vertex r found by unfolding the faces beyond the opposite edge that
+/// splits the angle into two acute ones, with the geometry of the virtual triangles (x; a, r) and
+/// (x; r, b).
+struct ObtuseSplit {
+  int vertex = -1;
+  CornerGeometry first, second;
+};
+
+/// One triangle of the fan around a vertex v: its two other vertices in order (v, a, b), the corner
+/// 3f + c of v, and which of the corners at a and b are obtuse (bits 1 and 2).
+struct FanTriangle {
+  int a = 0, b = 0;
+  int corner = 0;
+  std::uint8_t obtuse = 0;
+};
+
+/// The surface as flat arrays: the corners of each face, the face across the edge opposite each
+/// corner, and the fan of triangles around each vertex (CSR), which the marching loop reads
+/// sequentially.
+struct FlatMesh {
+  std::size_t nv = 0, nf = 0;
+  std::vector<Vec3> points;
+  std::vector<int> corner_vertex;   // 3f + c → vertex
+  std::vector<int> across;          // 3f + c → face across the edge opposite corner c, or −1
+  std::vector<int> obtuse;          // 3f + c → index into splits, −2 obtuse without split, −1 not obtuse
+  std::vector<ObtuseSplit> splits;
+  std::vector<int> fan_start;       // vertex → its fan triangles (CSR)
+  std::vector<FanTriangle> fan;
+};
+
+FlatMesh flatten(const SurfaceMesh& mesh) {
+  FlatMesh m;
+  m.nv = mesh.n_vertices();
+  m.nf = mesh.n_faces();
+  m.points.resize(m.nv);
+  for (std::size_t i = 0; i < m.nv; ++i) m.points[i] = mesh.point(VertexHandle(int(i)));
+  m.corner_vertex.resize(3 * m.nf);
+  m.across.resize(3 * m.nf);
+  m.obtuse.assign(3 * m.nf, -1);
+  for (std::size_t f = 0; f < m.nf; ++f) {
+    if (mesh.status(FaceHandle(int(f))).deleted())
+      throw InputError("signed_distance: the mesh must be garbage-collected");
+    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
+    const auto h1 = mesh.next_halfedge_handle(h0);
+    const auto h2 = mesh.next_halfedge_handle(h1);
+    m.corner_vertex[3 * f + 0] = mesh.from_vertex_handle(h0).idx();
+    m.corner_vertex[3 * f + 1] = mesh.to_vertex_handle(h0).idx();
+    m.corner_vertex[3 * f + 2] = mesh.to_vertex_handle(h1).idx();
+    // corner c is opposite the halfedge from corner c+1 to corner c+2
+    m.across[3 * f + 0] = mesh.opposite_face_handle(h1).idx();
+    m.across[3 * f + 1] = mesh.opposite_face_handle(h2).idx();
+    m.across[3 * f + 2] = mesh.opposite_face_handle(h0).idx();
+  }
+  return m;
+}
+
+/// The fans, after the obtuse corners are known.
+void build_fans(FlatMesh& m) {
+  m.fan_start.assign(m.nv + 1, 0);
+  for (int v : m.corner_vertex) ++m.fan_start[v + 1];
+  for (std::size_t i = 0; i < m.nv; ++i) m.fan_start[i + 1] += m.fan_start[i];
+  m.fan.resize(3 * m.nf);
+  std::vector<int> fill(m.fan_start.begin(), m.fan_start.end() - 1);
+  for (std::size_t k = 0; k < 3 * m.nf; ++k) {
+    const std::size_t f = k / 3, c = k % 3;
+    FanTriangle t;
+    t.a = m.corner_vertex[3 * f + (c + 1) % 3];
+    t.b = m.corner_vertex[3 * f + (c + 2) % 3];
+    t.corner = int(k);
+    t.obtuse = std::uint8_t((m.obtuse[3 * f + (c + 1) % 3] != -1 ? 1 : 0) | (m.obtuse[3 * f + (c + 2) % 3] != -1 ? 2 : 0));
+    m.fan[fill[m.corner_vertex[k]]++] = t;
+  }
+}
+
+/// Position of the third vertex of the triangle (p, q, r) unfolded into the plane of the 2-D points
+/// P, Q (p → P, q → Q), on the side opposite `away`.
+std::array<double, 2> unfold(const Vec3& p, const Vec3& q, const Vec3& r, std::array<double, 2> P,
+                             std::array<double, 2> Q, std::array<double, 2> away) {
+  const Vec3 e = q - p, w = r - p;
+  const double len2 = e.sqrnorm();
+  const double s = (w | e) / len2;                     // coordinate along pq
+  const double hgt = (w - e * s).norm();               // distance of r from the line pq
+  const std::array<double, 2> E{Q[0] - P[0], Q[1] - P[1]};
+  const double len = std::sqrt(E[0] * E[0] + E[1] * E[1]);
+  std::array<double, 2> n{-E[1] / len, E[0] / len};
+  if ((away[0] - P[0]) * n[0] + (away[1] - P[1]) * n[1] > 0) n = {-n[0], -n[1]};
+  return {P[0] + s * E[0] + hgt * n[0], P[1] + s * E[1] + hgt * n[1]};
+}
+
+/// Kimmel–Sethian unfolding for the obtuse corner k = 3f + c: walk across the faces beyond the
+/// opposite edge, unfolded into the plane of f, until a vertex falls in the section of the angle
+/// where both sub-angles are acute.
+void split_obtuse_corner(FlatMesh& m, int k) {
+  const int f = k / 3, c = k % 3;
+  const int xv = m.corner_vertex[k];
+  int pv = m.corner_vertex[3 * f + (c + 1) % 3], qv = m.corner_vertex[3 * f + (c + 2) % 3];
+  const Vec3& x = m.points[xv];
+  const Vec3 ea = m.points[pv] - x, eb = m.points[qv] - x;
+  const double la = ea.norm();
+  // 2-D frame: x at the origin, a on the first axis.
+  const std::array<double, 2> X{0, 0};
+  const double bx = (eb | ea) / la;
+  const std::array<double, 2> A0{la, 0}, B0{bx, (eb - ea * (bx / la)).norm()};
+  auto dot = [](std::array<double, 2> u, std::array<double, 2> v) { return u[0] * v[0] + u[1] * v[1]; };
+  std::array<double, 2> P = A0, Q = B0;
+  int face = f;
+  int far_corner = c;  // corner of `face` opposite the edge (pv, qv)
+  for (int step = 0; step < 16; ++step) {
+    const int next = m.across[3 * face + far_corner];
+    if (next < 0) return;
+    int rc = 0;  // the corner of `next` that is neither pv nor qv
+    for (int i = 0; i < 3; ++i) {
+      const int w = m.corner_vertex[3 * next + i];
+      if (w != pv && w != qv) rc = i;
+    }
+    const int rv = m.corner_vertex[3 * next + rc];
+    // The unfolded r lies on the side of pq away from x (x is on the near side for every strip face).
+    const std::array<double, 2> R = unfold(m.points[pv], m.points[qv], m.points[rv], P, Q, X);
+    // Acute section: r·a > 0 and r·b > 0 (both sub-angles below 90°).
+    const bool acute_a = dot(R, A0) > 0, acute_b = dot(R, B0) > 0;
+    if (acute_a && acute_b) {
+      const Vec3 ea3{A0[0], A0[1], 0}, eb3{B0[0], B0[1], 0}, er3{R[0], R[1], 0};
+      ObtuseSplit s;
+      s.vertex = rv;
+      s.first = corner_geometry(ea3, er3);
+      s.second = corner_geometry(er3, eb3);
+      m.obtuse[k] = int(m.splits.size());
+      m.splits.push_back(s);
+      return;
+    }
+    // Continue across the edge of `next` that the section crosses: if r is on a's side of the
+    // section (too close to a: r·b ≤ 0), the section lies between r and q.
+    face = next;
+    if (!acute_b) {
+      pv = rv;
+      P = R;
+    } else {
+      qv = rv;
+      Q = R;
+    }
+    for (int i = 0; i < 3; ++i) {
+      const int w = m.corner_vertex[3 * face + i];
+      if (w != pv && w != qv) far_corner = i;
+    }
+  }
+}
+
+void find_obtuse_corners(FlatMesh& m) {
+  for (std::size_t k = 0; k < 3 * m.nf; ++k) {
+    const int f = int(k / 3), c = int(k % 3);
+    const Vec3& x = m.points[m.corner_vertex[3 * f + c]];
+    const Vec3& a = m.points[m.corner_vertex[3 * f + (c + 1) % 3]];
+    const Vec3& b = m.points[m.corner_vertex[3 * f + (c + 2) % 3]];
+    if (((a - x) | (b - x)) < 0) {
+      m.obtuse[k] = -2;  // obtuse, no split found (yet)
+      split_obtuse_corner(m, int(k));
+    }
+  }
+}
+
+double point_segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 e = b - a;
+  const double len2 = e.sqrnorm();
+  double t = len2 > 0 ? ((p - a) | e) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  return (p - (a + e * t)).norm();
+}
+
+/// What the initialisation needs: the sign of each vertex (−1, 0, +1) and, for every face touched
+/// by the interface, the interface segments inside it.
+struct Seeds {
+  std::vector<signed char> sign;
+  std::vector<int> faces;                       // seed faces
+  std::vector<int> seg_start;                   // per seed face, into segments (CSR)
+  std::vector<std::pair<Vec3, Vec3>> segments;  // a point is a segment with equal ends
+};
+
+Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
+  Seeds s;
+  s.sign.resize(m.nv);
+  for (std::size_t v = 0; v < m.nv; ++v) s.sign[v] = phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0;
+  s.seg_start.push_back(0);
+  for (std::size_t f = 0; f < m.nf; ++f) {
+    std::array<Vec3, 3> zero;
+    int count = 0;
+    for (int c = 0; c < 3; ++c) {
+      const int a = m.corner_vertex[3 * f + c], b = m.corner_vertex[3 * f + (c + 1) % 3];
+      if (s.sign[a] == 0) zero[count++] = m.points[a];
+      if (s.sign[a] * s.sign[b] < 0) {
+        const double t = phi[a] / (phi[a] - phi[b]);  // scale-free
+        zero[count++] = m.points[a] + (m.points[b] - m.points[a]) * t;
+      }
+    }
+    if (count == 0) continue;
+    s.faces.push_back(int(f));
+    if (count == 1) s.segments.emplace_back(zero[0], zero[0]);
+    else if (count == 2) s.segments.emplace_back(zero[0], zero[1]);
+    else
+      for (int i = 0; i < 3; ++i) s.segments.emplace_back(zero[i], zero[(i + 1) % 3]);
+    s.seg_start.push_back(int(s.segments.size()));
+  }
+  return s;
+}
+
+Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m) {
+  Seeds s;
+  s.sign.assign(m.nv, 1);
+  for (std::size_t f = 0; f < m.nf; ++f)
+    if (mesh.inside(FaceHandle(int(f))))
+      for (int c = 0; c < 3; ++c) s.sign[m.corner_vertex[3 * f + c]] = -1;
+  std::vector<char> on_interface(m.nv, 0);
+  for (auto e : mesh.edges()) {
+    if (!mesh.interface(e)) continue;
+    const auto h = mesh.halfedge_handle(e, 0);
+    on_interface[mesh.from_vertex_handle(h).idx()] = 1;
+    on_interface[mesh.to_vertex_handle(h).idx()] = 1;
+  }
+  for (std::size_t v = 0; v < m.nv; ++v)
+    if (on_interface[v]) s.sign[v] = 0;
+  s.seg_start.push_back(0);
+  for (std::size_t f = 0; f < m.nf; ++f) {
+    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
+    bool seed = false;
+    for (auto h : {h0, mesh.next_halfedge_handle(h0), mesh.prev_halfedge_handle(h0)}) {
+      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+      if (mesh.interface(mesh.edge_handle(h))) {
+        s.segments.emplace_back(m.points[a], m.points[b]);
+        seed = true;
+      } else if (on_interface[a]) {
+        s.segments.emplace_back(m.points[a], m.points[a]);
+        seed = true;
+      }
+    }
+    if (!seed) continue;
+    s.faces.push_back(int(f));
+    s.seg_start.push_back(int(s.segments.size()));
+  }
+  return s;
+}
+
+using HeapEntry = std::pair<double, int>;
+using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<>>;
+
+ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options,
+                  DistanceReport& report) {
+  const std::size_t nv = m.nv;
+  std::vector<double> dist(nv, kInf);
+  // 0 far, 1 tentative, 2 fixed by the initialisation (final, not yet expanded), 3 accepted
+  std::vector<std::uint8_t> state(nv, 0);
+  report.has_interface = !seeds.faces.empty();
+
+  // Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
+  // segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
+  // this differs from the geodesic distance by O(h³), far below the O(h²) of the P1 zero set.
+  // The vertices one and two rings further get the same direct distance as a tentative value (the
+  // march may still lower it), which keeps the near field second-order accurate.
+  std::vector<int> stamp(nv, -1);
+  std::vector<int> ring;
+  for (std::size_t i = 0; i < seeds.faces.size(); ++i) {
+    const int f = seeds.faces[i];
+    ring.clear();
+    for (int c = 0; c < 3; ++c) {
+      const int u = m.corner_vertex[3 * f + c];
+      stamp[u] = int(i);
+      ring.push_back(u);
+      state[u] = 2;
+    }
+    for (int depth = 0, begin = 0; depth < 3; ++depth) {  // up to 3 rings around the face
+      const int end = int(ring.size());
+      for (int r = begin; r < end; ++r)
+        for (int j = m.fan_start[ring[r]]; j < m.fan_start[ring[r] + 1]; ++j)
+          for (int w : {m.fan[j].a, m.fan[j].b})
+            if (stamp[w] != int(i)) {
+              stamp[w] = int(i);
+              ring.push_back(w);
+            }
+      begin = end;
+    }
+    for (int w : ring) {
+      const Vec3& p = m.points[w];
+      double best = dist[w];
+      for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k)
+        best = std::min(best, point_segment_distance(p, seeds.segments[k].first, seeds.segments[k].second));
+      dist[w] = best;
+    }
+  }
+  MinHeap heap;
+  for (std::size_t v = 0; v < nv; ++v) {
+    if (seeds.sign[v] == 0) dist[v] = 0;
+    if (dist[v] == kInf) continue;
+    if (state[v] == 0) {
+      // Every interface point within Euclidean distance 2·(shortest edge at v) lies in a seed face
+      // within 3 rings of v, so a direct distance below that bound is final.
+      double shortest = kInf;
+      for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
+        shortest = std::min(shortest, (m.points[m.fan[j].a] - m.points[v]).sqrnorm());
+      state[v] = dist[v] * dist[v] <= 4 * shortest ? 2 : 1;
+    }
+    if (state[v] == 2) ++report.initialised;
+    heap.emplace(dist[v], int(v));
+  }
+
+  auto known = [&](int v) { return state[v] >= 2; };
+  while (!heap.empty()) {
+    const auto [d, v] = heap.top();
+    heap.pop();
+    if (state[v] == 3 || d > dist[v]) continue;
+    if (d > options.narrow_band) break;
+    if (state[v] == 1) ++report.marched;
+    state[v] = 3;
+    const Vec3& pv = m.points[v];
+    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j) {
+      const FanTriangle& t = m.fan[j];
+      for (int side = 0; side < 2; ++side) {
+        const int x = side == 0 ? t.a : t.b;
+        if (known(x)) continue;
+        const int y = side == 0 ? t.b : t.a;
+        const Vec3& px = m.points[x];
+        const Vec3 ev = pv - px;
+        double value = kInf;
+        if (!(t.obtuse & (1 << side))) {
+          if (known(y)) value = triangle_update(corner_geometry(ev, m.points[y] - px), d, dist[y]);
+        } else {  // obtuse angle at x: the two acute virtual triangles of the unfolding
+          const int f = t.corner / 3, cx = (t.corner % 3 + 1 + side) % 3;
+          const int split = m.obtuse[3 * f + cx];
+          if (split >= 0) {
+            const ObtuseSplit& s = m.splits[split];
+            const int a = m.corner_vertex[3 * f + (cx + 1) % 3], b = m.corner_vertex[3 * f + (cx + 2) % 3];
+            if (known(s.vertex)) {
+              if (known(a)) value = std::min(value, triangle_update(s.first, dist[a], dist[s.vertex]));
+              if (known(b)) value = std::min(value, triangle_update(s.second, dist[s.vertex], dist[b]));
+            }
+          }
+        }
+        if (value == kInf) value = d + ev.norm();
+        if (value < dist[x]) {
+          dist[x] = value;
+          state[x] = 1;
+          heap.emplace(value, x);
+        }
+      }
+    }
+  }
+  ScalarField result(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    const double value = state[v] == 3 && dist[v] <= options.narrow_band ? dist[v] : kInf;
+    result[v] = seeds.sign[v] > 0 ? value : seeds.sign[v] < 0 ? -value : 0.0;
+  }
+  return result;
+}
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <class MakeSeeds>
+ScalarField run(const SurfaceMesh& mesh, const DistanceOptions& options, DistanceReport* report,
+                MakeSeeds make_seeds) {
+  DistanceReport local;
+  auto start = std::chrono::steady_clock::now();
+  FlatMesh m = flatten(mesh);
+  find_obtuse_corners(m);
+  build_fans(m);
+  local.setup_ms = milliseconds_since(start);
+  start = std::chrono::steady_clock::now();
+  const Seeds seeds = make_seeds(m);
+  local.init_ms = milliseconds_since(start);
+  start = std::chrono::steady_clock::now();
+  ScalarField d = march(m, seeds, options, local);
+  local.march_ms = milliseconds_since(start);
+  if (report) *report = local;
+  return d;
+}
+
+}  // namespace
+
+ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi, const DistanceOptions& options,
+                            DistanceReport* report) {
+  if (phi.size() != mesh.n_vertices())
+    throw InputError("signed_distance: the level set has " + std::to_string(phi.size()) + " values for " +
+                     std::to_string(mesh.n_vertices()) + " vertices");
+  for (double value : phi)
+    if (!std::isfinite(value)) throw InputError("signed_distance: the level set has a non-finite value");
+  return run(mesh, options, report, [&](const FlatMesh& m) { return seeds_from_phi(m, phi); });
+}
+
+ScalarField signed_distance_to_region(const SurfaceMesh& mesh, const DistanceOptions& options,
+                                      DistanceReport* report) {
+  return run(mesh, options, report, [&](const FlatMesh& m) { return seeds_from_region(mesh, m); });
+}
+
+}  // namespace bodyfit
