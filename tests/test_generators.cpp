@@ -81,3 +81,289 @@ TEST_CASE("sphere: bad options are input errors") {
   CHECK_THROWS_AS(make_sphere({.faces = 19}), InputError);
   CHECK_THROWS_AS(make_sphere({.faces = 100, .radius = 0}), InputError);
 }
+
+// ---- terrains ------------------------------------------------------------------------------------
+
+namespace {
+
+TerrainOptions small_terrain(std::uint64_t seed = 7) {
+  return {.extent = 20000, .h = 500, .seed = seed, .max_height = 2500, .feature_size = 8000};
+}
+
+double plan_quality(const SurfaceMesh& mesh, FaceHandle f) {
+  auto p = face_points(mesh, f);
+  for (auto& x : p) x[2] = 0;
+  return triangle_quality(p[0], p[1], p[2]);
+}
+
+bool on_square_side(const Vec3& p, double extent) {
+  return p[0] == 0 || p[0] == extent || p[1] == 0 || p[1] == extent;
+}
+
+}  // namespace
+
+TEST_CASE("terrain: an open disc over the square, straight sides, corners at the domain corners") {
+  const auto options = small_terrain();
+  auto mesh = make_terrain(options);
+  CHECK(euler_characteristic(mesh) == 1);
+  CHECK(connected_components(mesh) == 1);
+  auto loops = boundary_loops(mesh);
+  REQUIRE(loops.size() == 1);
+  double plan_length = 0;
+  for (std::size_t i = 0; i < loops[0].size(); ++i) {
+    Vec3 a = mesh.point(loops[0][i]), b = mesh.point(loops[0][(i + 1) % loops[0].size()]);
+    CHECK(on_square_side(a, options.extent));
+    // Each boundary edge lies along one side: x or y constant.
+    CHECK((a[0] == b[0] || a[1] == b[1]));
+    a[2] = b[2] = 0;
+    plan_length += (b - a).norm();
+  }
+  CHECK(plan_length == doctest::Approx(4 * options.extent).epsilon(1e-12));
+  std::vector<Vec3> corners;
+  for (auto v : mesh.vertices())
+    if (mesh.corner(v)) corners.push_back(mesh.point(v));
+  REQUIRE(corners.size() == 4);
+  for (auto [x, y] : {std::pair{0.0, 0.0}, {options.extent, 0.0}, {0.0, options.extent}, {options.extent, options.extent}}) {
+    int found = 0;
+    for (const auto& c : corners) found += c[0] == x && c[1] == y;
+    CHECK(found == 1);
+  }
+}
+
+TEST_CASE("terrain: heights are the height function, within [0, max], and vary") {
+  const auto options = small_terrain();
+  auto mesh = make_terrain(options);
+  double lo = 1e300, hi = -1e300;
+  for (auto v : mesh.vertices()) {
+    const auto p = mesh.point(v);
+    CHECK(p[2] == terrain_height(options, p[0], p[1]));
+    CHECK(p[2] >= 0);
+    CHECK(p[2] <= options.max_height);
+    lo = std::min(lo, p[2]), hi = std::max(hi, p[2]);
+  }
+  // A landscape, not a plateau: hundreds of metres of relief over 20 km.
+  CHECK(hi - lo > 0.2 * options.max_height);
+  // Smooth: the height function is continuous (tiny steps give tiny changes).
+  for (double x : {1234.5, 7777.7, 15000.1}) {
+    double z = terrain_height(options, x, 4321.0);
+    CHECK(std::abs(terrain_height(options, x + 1e-3, 4321.0) - z) < 1e-2);
+  }
+}
+
+TEST_CASE("terrain: near-equilateral in plan view, edges about h, normals up") {
+  const auto options = small_terrain();
+  auto mesh = make_terrain(options);
+  double min_q = 1;
+  for (auto f : mesh.faces()) {
+    min_q = std::min(min_q, plan_quality(mesh, f));
+    CHECK(face_normal(mesh, f)[2] > 0);
+  }
+  CHECK(min_q >= 0.74);
+  std::size_t in_range = 0;
+  for (auto e : mesh.edges()) {
+    double l = edge_length(mesh, e);
+    in_range += l >= 0.7 * options.h && l <= 1.4 * options.h;
+  }
+  CHECK(double(in_range) >= 0.95 * double(mesh.n_edges()));
+  // About (extent / h)² · 2/√3 · 2 faces.
+  const double expected = 2 * (options.extent / options.h) * (options.extent / (options.h * std::sqrt(3.0) / 2));
+  CHECK(std::abs(double(mesh.n_faces()) - expected) < 0.05 * expected);
+}
+
+TEST_CASE("terrain: reproducible for a seed, different for another") {
+  auto a = make_terrain(small_terrain(7)), b = make_terrain(small_terrain(7)), c = make_terrain(small_terrain(8));
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  REQUIRE(a.n_vertices() == c.n_vertices());
+  bool same = true;
+  std::size_t differ = 0;
+  for (auto v : a.vertices()) {
+    same = same && a.point(v) == b.point(v);
+    differ += std::abs(a.point(v)[2] - c.point(v)[2]) > 1.0;
+  }
+  CHECK(same);
+  CHECK(differ > a.n_vertices() / 2);
+  for (auto f : a.faces()) CHECK(face_vertices(a, f) == face_vertices(b, f));
+}
+
+TEST_CASE("terrain: bad options are input errors") {
+  auto o = small_terrain();
+  o.h = 0;
+  CHECK_THROWS_AS(make_terrain(o), InputError);
+  o = small_terrain();
+  o.extent = -1;
+  CHECK_THROWS_AS(make_terrain(o), InputError);
+  o = small_terrain();
+  o.h = 0.01;  // 4·10¹² triangles
+  CHECK_THROWS_AS(make_terrain(o), InputError);
+}
+
+// ---- DEM rasters ---------------------------------------------------------------------------------
+
+namespace {
+
+// Heights of the plane z = 100 + 0.5 x − 0.25 y at the cell centres.
+HeightGrid plane_grid() {
+  HeightGrid g;
+  g.cols = 7, g.rows = 5, g.x_origin = 1000, g.y_origin = 2000, g.cell_size = 30;
+  for (std::size_t r = 0; r < g.rows; ++r)
+    for (std::size_t c = 0; c < g.cols; ++c) {
+      double x = g.x_origin + (double(c) + 0.5) * g.cell_size;
+      double y = g.y_origin + (double(g.rows - r) - 0.5) * g.cell_size;
+      g.heights.push_back(100 + 0.5 * x - 0.25 * y);
+    }
+  return g;
+}
+
+double plane(double x, double y) { return 100 + 0.5 * x - 0.25 * y; }
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream(file) << text;
+}
+
+std::string error_of(const std::filesystem::path& file) {
+  try {
+    read_esri_ascii(file);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST_CASE("dem: bilinear sampling is exact on a plane inside the cell centres, clamped outside") {
+  const auto g = plane_grid();
+  for (double x : {1015.0, 1030.0, 1047.3, 1100.0, 1195.0})
+    for (double y : {2015.0, 2033.3, 2100.0, 2135.0}) CHECK(g.sample(x, y) == doctest::Approx(plane(x, y)).epsilon(1e-13));
+  // Outside the centres the value is the nearest centre row/column's.
+  CHECK(g.sample(1000.0, 2015.0) == doctest::Approx(plane(1015.0, 2015.0)));
+  CHECK(g.sample(5000.0, 9000.0) == doctest::Approx(plane(1195.0, 2135.0)));
+}
+
+TEST_CASE("dem: ESRI ASCII round trip is exact") {
+  bodyfit::test::TempDir dir("dem_roundtrip");
+  auto g = plane_grid();
+  g.heights[3] = 1.0 / 3.0;
+  write_esri_ascii(dir / "g.asc", g);
+  auto r = read_esri_ascii(dir / "g.asc");
+  CHECK(r.cols == g.cols);
+  CHECK(r.rows == g.rows);
+  CHECK(r.x_origin == g.x_origin);
+  CHECK(r.y_origin == g.y_origin);
+  CHECK(r.cell_size == g.cell_size);
+  CHECK(r.heights == g.heights);
+  auto d = read_dem(dir / "g.asc");
+  CHECK(d.heights == g.heights);
+}
+
+TEST_CASE("dem: header variants: centre registration, any case, optional NODATA") {
+  bodyfit::test::TempDir dir("dem_header");
+  write_text(dir / "c.asc", "NCOLS 2\nNROWS 2\nXLLCENTER 10\nYLLCENTER 20\nCELLSIZE 4\n1 2\n3 4\n");
+  auto g = read_esri_ascii(dir / "c.asc");
+  CHECK(g.x_origin == 8);
+  CHECK(g.y_origin == 18);
+  CHECK(g.at(0, 1) == 2);
+  CHECK(g.at(1, 0) == 3);
+  // South-west cell centre is (10, 20): value 3 (row 1 is the south row).
+  CHECK(g.sample(10, 20) == 3);
+}
+
+TEST_CASE("dem: NODATA cells take the nearest valid height; all-NODATA is an error") {
+  bodyfit::test::TempDir dir("dem_nodata");
+  write_text(dir / "n.asc",
+             "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n"
+             "5 5 -9999 7\n5 5 6 -9999\n-9999 -9999 -9999 8\n");
+  auto g = read_esri_ascii(dir / "n.asc");
+  for (double v : g.heights) CHECK(v != -9999);
+  // Each filled cell takes the value of a valid cell among its direct neighbours.
+  CHECK((g.at(0, 2) == 5 || g.at(0, 2) == 6 || g.at(0, 2) == 7));
+  // (1, 3) touches 7, 6 and 8; the breadth-first fill takes a direct neighbour's value.
+  CHECK((g.at(1, 3) == 7 || g.at(1, 3) == 6 || g.at(1, 3) == 8));
+  CHECK((g.at(2, 0) == 5));
+  write_text(dir / "all.asc", "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -1\n-1 -1\n");
+  CHECK(error_of(dir / "all.asc").find("NODATA") != std::string::npos);
+}
+
+TEST_CASE("dem: malformed ESRI ASCII grids name the file and the line") {
+  bodyfit::test::TempDir dir("dem_bad");
+  const std::string header = "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 10\n";
+  struct Case {
+    std::string name, text, line, what;
+  };
+  const Case cases[] = {
+      {"missing_key", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\n1 2 3\n4 5 6\n", ":5:", "cellsize"},
+      {"missing_origin", "ncols 3\nnrows 2\nxllcorner 0\ncellsize 1\n1 2 3\n4 5 6\n", ":5:", "yllcorner"},
+      {"too_few", header + "1 2 3\n4 5\n", ":7:", "truncated"},
+      {"too_many", header + "1 2 3\n4 5 6\n7\n", ":8:", "too many"},
+      {"not_a_number", header + "1 2 3\n4 x5 6\n", ":7:", "x5"},
+      {"bad_header_value", "ncols 3\nnrows two\nxllcorner 0\nyllcorner 0\ncellsize 10\n1 2 3\n4 5 6\n", ":2:", "two"},
+      {"unknown_key", "ncols 3\nnrows 2\nzllcorner 0\n", ":3:", "zllcorner"},
+      {"fractional_count", "ncols 3.5\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 10\n1 2 3\n", ":1:", "ncols"},
+      {"empty", "", ":1:", "ncols"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.name);
+    auto file = dir / (c.name + ".asc");
+    write_text(file, c.text);
+    std::string message = error_of(file);
+    CAPTURE(message);
+    CHECK(message.find(file.string() + c.line) == 0);
+    CHECK(message.find(c.what) != std::string::npos);
+  }
+  CHECK_THROWS_AS(read_esri_ascii(dir / "does_not_exist.asc"), InputError);
+  CHECK_THROWS_AS(read_dem(dir / "x.xyz"), InputError);
+}
+
+TEST_CASE("dem: a GeoTIFF made by gdal_translate reads as the .asc it came from") {
+  bodyfit::test::TempDir dir("dem_tif");
+  auto g = plane_grid();
+  g.heights[0] = g.nodata;  // filled the same way from both files
+  g.heights[9] = 0.1;       // not a float: the .asc is read and the .tif written as Float64
+  write_esri_ascii(dir / "g.asc", g);
+  const auto tif = dir / "g.tif";
+  if (!config::have_gdal) {
+    write_text(tif, "not really a tiff");
+    CHECK_THROWS_WITH_AS(read_geotiff(tif), doctest::Contains("without GDAL"), InputError);
+    return;
+  }
+  if (std::system("command -v gdal_translate > /dev/null 2>&1") != 0) {
+    MESSAGE("gdal_translate not found (Debian package gdal-bin): GeoTIFF comparison skipped");
+    return;
+  }
+  const std::string command = "gdal_translate -q -oo DATATYPE=Float64 -of GTiff -ot Float64 '" + (dir / "g.asc").string() + "' '" +
+                              tif.string() + "'";
+  REQUIRE(std::system(command.c_str()) == 0);
+  auto a = read_esri_ascii(dir / "g.asc");
+  auto t = read_dem(tif);
+  CHECK(t.cols == a.cols);
+  CHECK(t.rows == a.rows);
+  CHECK(t.x_origin == a.x_origin);
+  CHECK(t.y_origin == a.y_origin);
+  CHECK(t.cell_size == a.cell_size);
+  CHECK(t.heights == a.heights);
+  write_text(dir / "bad.tif", "not a tiff");
+  CHECK_THROWS_AS(read_geotiff(dir / "bad.tif"), InputError);
+}
+
+TEST_CASE("dem: terrain over the raster's extent, heights bilinear") {
+  const auto g = plane_grid();
+  auto mesh = make_terrain_from_grid(g);
+  CHECK(euler_characteristic(mesh) == 1);
+  REQUIRE(boundary_loops(mesh).size() == 1);
+  auto box = bounding_box(mesh);
+  CHECK(box.min[0] == 1000);
+  CHECK(box.max[0] == 1000 + 7 * 30);
+  CHECK(box.min[1] == 2000);
+  CHECK(box.max[1] == 2000 + 5 * 30);
+  for (auto v : mesh.vertices()) {
+    auto p = mesh.point(v);
+    CHECK(p[2] == doctest::Approx(g.sample(p[0], p[1])).epsilon(1e-14));
+    // Inside the band of cell centres the plane is reproduced exactly.
+    if (p[0] >= 1015 && p[0] <= 1195 && p[1] >= 2015 && p[1] <= 2135)
+      CHECK(p[2] == doctest::Approx(plane(p[0], p[1])).epsilon(1e-12));
+  }
+  // Default edge length: the cell size.
+  CHECK(edge_length_stats(mesh).mean == doctest::Approx(30).epsilon(0.15));
+  auto finer = make_terrain_from_grid(g, 10);
+  CHECK(finer.n_faces() > 5 * mesh.n_faces());
+}
