@@ -1,20 +1,665 @@
-// Temporary: returns the mesh unchanged (valid), replaced by the full remesher shortly.
+// Interface-preserving adaptive remeshing: split / collapse / flip / relocate driven by a sizing
+// field, on a work queue of "active" vertices so that the cost follows the part of the mesh that
+// needs change. See docs/validation/remeshing.md for the algorithm and its defaults.
 #include <bodyfit/remesh.hpp>
-#include <bodyfit/geometry.hpp>
 
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/projection.hpp>
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <queue>
+#include <vector>
 
 namespace bodyfit {
 
-RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions&) {
+namespace {
+
+// Kinds of feature curves an edge can belong to (the label of the reference polyline).
+constexpr char kNoCurve = 0, kInterfaceCurve = 1, kRidgeCurve = 2, kBoundaryCurve = 3, kRequiredCurve = 4;
+// Vertex kinds: free on S, sliding along one feature curve, locked.
+constexpr char kFreeVertex = 0, kCurveVertex = 1, kLockedVertex = 2;
+
+// Botsch–Kobbelt thresholds relative to the target size: split above 4/3, collapse below 4/5.
+constexpr double kSplitRatio = 4.0 / 3.0;
+constexpr double kCollapseRatio = 4.0 / 5.0;
+// Faces of quality below this start the work queue (a geodesic sphere is ≥ 0.7 everywhere).
+constexpr double kGoodQuality = 0.6;
+// A collapse may create triangles down to this quality (never below the worst one it removes).
+constexpr double kAcceptQuality = 0.4;
+// Flips are tried only when the worse triangle of the pair is below this quality.
+constexpr double kFlipBelow = 0.75;
+// Relocation spreads at most this many rings away from a topological change or a bad element.
+constexpr char kSmoothRings = 3;
+
+struct Tri {
+  double quality = 0;
+  Vec3 normal{0, 0, 0};  // unit, zero if degenerate
+};
+
+Tri triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  Tri t;
+  Vec3 n = (b - a) % (c - a);
+  double twice_area = n.norm();
+  double l2 = (b - a).sqrnorm() + (c - b).sqrnorm() + (a - c).sqrnorm();
+  if (twice_area > 0 && l2 > 0) {
+    t.normal = n / twice_area;
+    t.quality = 2.0 * std::sqrt(3.0) * twice_area / l2;
+  }
+  return t;
+}
+
+class Remesher {
+ public:
+  Remesher(SurfaceMesh& mesh, const RemeshOptions& options) : m_(mesh), opt_(options) {
+    m_.add_property(size_);
+    m_.add_property(kind_);
+    m_.add_property(vcurve_);
+    m_.add_property(hint_);
+    m_.add_property(vnormal_);
+    m_.add_property(in_work_);
+    m_.add_property(in_next_);
+    m_.add_property(depth_);
+    m_.add_property(ecurve_);
+    m_.add_property(estamp_);
+  }
+  ~Remesher() {
+    m_.remove_property(size_);
+    m_.remove_property(kind_);
+    m_.remove_property(vcurve_);
+    m_.remove_property(hint_);
+    m_.remove_property(vnormal_);
+    m_.remove_property(in_work_);
+    m_.remove_property(in_next_);
+    m_.remove_property(depth_);
+    m_.remove_property(ecurve_);
+    m_.remove_property(estamp_);
+  }
+  Remesher(const Remesher&) = delete;
+  Remesher& operator=(const Remesher&) = delete;
+
+  RemeshReport run();
+
+ private:
+  void setup_sizes();
+  void classify_features();
+  void compute_sizing();
+  void seed_work();
+
+  double target(VertexHandle a, VertexHandle b) const { return std::min(m_.property(size_, a), m_.property(size_, b)); }
+  double length(EdgeHandle e) const { return edge_length(m_, e); }
+  void mark(VertexHandle v);
+  void mark_ring(VertexHandle v);
+  void mark_fresh(VertexHandle v) {
+    m_.property(depth_, v) = 0;
+    mark(v);
+  }
+  std::vector<EdgeHandle> work_edges();
+
+  bool split(EdgeHandle e);
+  bool collapse(EdgeHandle e);
+  bool collapse_check(HalfedgeHandle h, double& min_quality) const;
+  bool flip(EdgeHandle e);
+  double relocate(VertexHandle v);
+
+  Vec3 project_on_curve(const Vec3& p, char curve) const { return curves_.closest(p, curve); }
+
+  SurfaceMesh& m_;
+  RemeshOptions opt_;
+  std::shared_ptr<const ReferenceSurface> ref_;
+  ReferencePolyline curves_;
+  double hmin_ = 0, hmax_ = 0, hausd_ = 0, corner_angle_ = 0;
+  RemeshReport report_;
+
+  OpenMesh::VPropHandleT<double> size_;
+  OpenMesh::VPropHandleT<char> kind_, vcurve_;
+  OpenMesh::VPropHandleT<int> hint_;
+  OpenMesh::VPropHandleT<Vec3> vnormal_;
+  OpenMesh::VPropHandleT<char> in_work_, in_next_;
+  // Rings of smoothing since the last split/collapse/flip or bad element: bounds how far
+  // relocation spreads into the already-good mesh.
+  OpenMesh::VPropHandleT<char> depth_;
+  OpenMesh::EPropHandleT<char> ecurve_;
+  OpenMesh::EPropHandleT<int> estamp_;
+  int stamp_ = 0;
+  std::vector<VertexHandle> work_, next_;
+};
+
+void Remesher::setup_sizes() {
+  double diag = bounding_box(m_).diagonal();
+  if (diag <= 0) diag = 1;
+  hmax_ = opt_.hmax > 0 ? opt_.hmax : diag / 20;
+  hmin_ = opt_.hmin > 0 ? opt_.hmin : hmax_ / 20;
+  hmin_ = std::min(hmin_, hmax_);
+  hausd_ = opt_.hausd > 0 ? opt_.hausd : diag / 1000;
+  corner_angle_ = (opt_.feature_angle > 0 ? opt_.feature_angle : 45.0) * M_PI / 180.0;
+}
+
+void Remesher::classify_features() {
+  // Ridges by dihedral angle, added to the ridges read from the file.
+  if (opt_.feature_angle > 0) {
+    double cos_limit = std::cos(opt_.feature_angle * M_PI / 180.0);
+    for (auto e : m_.edges()) {
+      if (m_.is_boundary(e)) continue;
+      auto t0 = triangle(face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[0],
+                         face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[1],
+                         face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[2]);
+      auto p1 = face_points(m_, m_.face_handle(m_.halfedge_handle(e, 1)));
+      auto t1 = triangle(p1[0], p1[1], p1[2]);
+      // Slivers (e.g. fresh from discretize) have unreliable normals: no ridge from them.
+      if (t0.quality < 1e-3 || t1.quality < 1e-3) continue;
+      if ((t0.normal | t1.normal) < cos_limit) m_.ridge(e) = 1;
+    }
+  }
+  for (auto e : m_.edges()) {
+    char c = kNoCurve;
+    if (m_.required(e)) c = kRequiredCurve;
+    else if (m_.interface(e)) c = kInterfaceCurve;
+    else if (m_.ridge(e)) c = kRidgeCurve;
+    else if (m_.is_boundary(e)) c = kBoundaryCurve;
+    m_.property(ecurve_, e) = c;
+    if (c != kNoCurve && c != kRequiredCurve) {
+      auto h = m_.halfedge_handle(e, 0);
+      curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), c);
+    }
+  }
+  for (auto v : m_.vertices()) {
+    int count = 0;
+    char type = kNoCurve;
+    bool mixed = false, locked = m_.required(v) || m_.corner(v);
+    Vec3 dir[2];
+    for (auto h : m_.voh_range(v)) {
+      char c = m_.property(ecurve_, m_.edge_handle(h));
+      if (c == kNoCurve) continue;
+      if (c == kRequiredCurve) locked = true;
+      if (count > 0 && c != type) mixed = true;
+      type = c;
+      if (count < 2) dir[count] = m_.point(m_.to_vertex_handle(h)) - m_.point(v);
+      ++count;
+    }
+    if (m_.is_isolated(v)) locked = true;
+    if (count != 0 && count != 2) locked = true;
+    if (count == 2 && !locked && !mixed) {
+      double n0 = dir[0].norm(), n1 = dir[1].norm();
+      // Turning angle between the two curve edges: π − angle(d0, d1).
+      double c = n0 > 0 && n1 > 0 ? -(dir[0] | dir[1]) / (n0 * n1) : -1;
+      if (std::acos(std::clamp(c, -1.0, 1.0)) > corner_angle_) locked = true;
+    }
+    if (mixed) locked = true;
+    m_.property(kind_, v) = locked ? kLockedVertex : (count == 2 ? kCurveVertex : kFreeVertex);
+    m_.property(vcurve_, v) = count == 2 ? type : kNoCurve;
+    m_.property(vnormal_, v) = ref_->analytic() ? ref_->closest(m_.point(v)).normal : vertex_normal(m_, v);
+    int hint = -1;
+    if (!opt_.reference)
+      for (auto f : m_.vf_range(v)) hint = f.idx();
+    m_.property(hint_, v) = hint;
+  }
+}
+
+void Remesher::compute_sizing() {
+  // h ≤ sqrt(8 hausd / κ): the sag of a chord of length h on a curve of curvature κ is h²κ/8.
+  auto size_for = [&](double kappa) {
+    double h = kappa > 0 ? std::sqrt(8 * hausd_ / kappa) : hmax_;
+    return std::clamp(h, hmin_, hmax_);
+  };
+  double kappa_sphere = 0;
+  if (ref_->analytic()) kappa_sphere = 1.0 / ref_->sphere_radius();
+  bool uniform = true;
+  for (auto v : m_.vertices()) {
+    double kappa = kappa_sphere;
+    char kind = m_.property(kind_, v);
+    if (!ref_->analytic() && kind == kFreeVertex) {
+      // Osculating estimate 2|n·d|/|d|², over neighbours not much closer than the farthest one
+      // (tiny edges of fresh cuts give no curvature information).
+      double far = 0;
+      for (auto w : m_.vv_range(v)) far = std::max(far, (m_.point(w) - m_.point(v)).norm());
+      const Vec3& n = m_.property(vnormal_, v);
+      for (auto w : m_.vv_range(v)) {
+        Vec3 d = m_.point(w) - m_.point(v);
+        double l = d.norm();
+        if (l < 0.3 * far || l <= 0) continue;
+        kappa = std::max(kappa, 2 * std::abs(n | d) / (l * l));
+      }
+    }
+    if (kind == kCurveVertex) {
+      // Curve curvature from the circle through points about hmax/2 away along the curve.
+      Vec3 ends[2];
+      int found = 0;
+      for (auto h0 : m_.voh_range(v)) {
+        if (m_.property(ecurve_, m_.edge_handle(h0)) != m_.property(vcurve_, v)) continue;
+        HalfedgeHandle h = h0;
+        double walked = 0;
+        for (int step = 0; step < 8; ++step) {
+          walked += m_.calc_edge_length(h);
+          VertexHandle w = m_.to_vertex_handle(h);
+          if (walked >= 0.5 * hmax_ || m_.property(kind_, w) != kCurveVertex) break;
+          HalfedgeHandle next;
+          for (auto hn : m_.voh_range(w))
+            if (m_.property(ecurve_, m_.edge_handle(hn)) == m_.property(vcurve_, v) &&
+                m_.to_vertex_handle(hn) != m_.from_vertex_handle(h))
+              next = hn;
+          if (!next.is_valid()) break;
+          h = next;
+        }
+        if (found < 2) ends[found++] = m_.point(m_.to_vertex_handle(h));
+      }
+      if (found == 2) {
+        Vec3 a = ends[0] - m_.point(v), b = ends[1] - m_.point(v), c = ends[1] - ends[0];
+        double denom = a.norm() * b.norm() * c.norm();
+        if (denom > 0) kappa = std::max(kappa, 2 * (a % b).norm() / denom);
+      }
+    }
+    double h = size_for(kappa);
+    m_.property(size_, v) = h;
+    if (h < hmax_) uniform = false;
+  }
+  if (uniform) return;
+  // Gradation: h(w) ≤ h(v) + ln(hgrad)·|vw|, propagated from the small sizes outwards.
+  double slope = std::log(std::max(opt_.hgrad, 1.0 + 1e-6));
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (auto v : m_.vertices())
+    if (m_.property(size_, v) < hmax_) queue.emplace(m_.property(size_, v), v.idx());
+  while (!queue.empty()) {
+    auto [h, i] = queue.top();
+    queue.pop();
+    VertexHandle v(i);
+    if (h > m_.property(size_, v)) continue;
+    for (auto w : m_.vv_range(v)) {
+      double limit = h + slope * (m_.point(w) - m_.point(v)).norm();
+      if (limit < m_.property(size_, w)) {
+        m_.property(size_, w) = limit;
+        queue.emplace(limit, w.idx());
+      }
+    }
+  }
+}
+
+void Remesher::mark(VertexHandle v) {
+  if (!m_.property(in_next_, v)) {
+    m_.property(in_next_, v) = 1;
+    next_.push_back(v);
+  }
+  if (!m_.property(in_work_, v)) {
+    m_.property(in_work_, v) = 1;
+    work_.push_back(v);
+  }
+}
+
+void Remesher::mark_ring(VertexHandle v) {
+  mark_fresh(v);
+  for (auto w : m_.vv_range(v)) mark_fresh(w);
+}
+
+void Remesher::seed_work() {
+  if (!opt_.incremental) {
+    for (auto v : m_.vertices()) mark_fresh(v);
+    return;
+  }
+  for (auto f : m_.faces()) {
+    auto p = face_points(m_, f);
+    if (triangle(p[0], p[1], p[2]).quality < kGoodQuality)
+      for (auto v : m_.fv_range(f)) mark_fresh(v);
+  }
+  for (auto e : m_.edges()) {
+    auto h = m_.halfedge_handle(e, 0);
+    auto a = m_.from_vertex_handle(h), b = m_.to_vertex_handle(h);
+    double l = length(e), t = target(a, b);
+    if (l > kSplitRatio * t || l < kCollapseRatio * t) {
+      mark_fresh(a);
+      mark_fresh(b);
+    }
+  }
+}
+
+std::vector<EdgeHandle> Remesher::work_edges() {
+  ++stamp_;
+  std::vector<EdgeHandle> edges;
+  for (auto v : work_) {
+    if (m_.status(v).deleted()) continue;
+    for (auto e : m_.ve_range(v)) {
+      if (m_.property(estamp_, e) == stamp_) continue;
+      m_.property(estamp_, e) = stamp_;
+      edges.push_back(e);
+    }
+  }
+  return edges;
+}
+
+bool Remesher::split(EdgeHandle e) {
+  char curve = m_.property(ecurve_, e);
+  if (curve == kRequiredCurve) return false;
+  auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+  auto a = m_.from_vertex_handle(h0), b = m_.to_vertex_handle(h0);
+  Vec3 p = (m_.point(a) + m_.point(b)) * 0.5;
+  if (curve != kNoCurve) p = project_on_curve(p, curve);
+  SurfacePoint sp = ref_->closest(p, m_.property(hint_, a));
+  if (curve != kBoundaryCurve || ref_->analytic()) p = sp.point;
+
+  // The two (or one) opposite vertices and their face regions; the new point must not fold them.
+  VertexHandle opposite[2];
+  int region[2] = {0, 0};
+  for (int s = 0; s < 2; ++s) {
+    auto h = s == 0 ? h0 : h1;
+    if (m_.is_boundary(h)) continue;
+    opposite[s] = m_.to_vertex_handle(m_.next_halfedge_handle(h));
+    region[s] = m_.region(m_.face_handle(h));
+    auto from = m_.from_vertex_handle(h), to = m_.to_vertex_handle(h);
+    Vec3 o = m_.point(opposite[s]);
+    Vec3 n_old = triangle(m_.point(from), m_.point(to), o).normal;
+    if (n_old.sqrnorm() == 0) n_old = m_.property(vnormal_, a);
+    auto t1 = triangle(m_.point(from), p, o), t2 = triangle(p, m_.point(to), o);
+    if ((t1.normal | n_old) < 0.3 || (t2.normal | n_old) < 0.3) return false;
+  }
+  // Edge attributes carried by the two halves.
+  bool interface = m_.interface(e), ridge = m_.ridge(e);
+  int ref = m_.edge_ref(e);
+  double size = 0.5 * (m_.property(size_, a) + m_.property(size_, b));
+  double phi = curve == kInterfaceCurve ? 0.0 : 0.5 * (m_.phi(a) + m_.phi(b));
+
+  auto v = m_.add_vertex(p);
+  m_.split(e, v);
+  m_.property(size_, v) = size;
+  m_.property(kind_, v) = curve == kNoCurve ? kFreeVertex : kCurveVertex;
+  m_.property(vcurve_, v) = curve;
+  m_.property(hint_, v) = sp.face;
+  m_.property(vnormal_, v) = sp.normal;
+  m_.property(in_work_, v) = 0;
+  m_.property(in_next_, v) = 0;
+  m_.phi(v) = phi;
+  m_.vertex_ref(v) = 0;
+  m_.corner(v) = 0;
+  m_.required(v) = 0;
+  for (auto h : m_.voh_range(v)) {
+    auto ee = m_.edge_handle(h);
+    auto w = m_.to_vertex_handle(h);
+    bool half = w == a || w == b;
+    m_.interface(ee) = half && interface;
+    m_.ridge(ee) = half && ridge;
+    m_.required(ee) = 0;
+    m_.edge_ref(ee) = half ? ref : 0;
+    m_.property(ecurve_, ee) = half ? curve : kNoCurve;
+    m_.property(estamp_, ee) = 0;
+    if (!m_.is_boundary(h)) {
+      auto f = m_.face_handle(h);
+      for (auto u : m_.fv_range(f)) {
+        if (opposite[0].is_valid() && u == opposite[0]) m_.region(f) = region[0];
+        if (opposite[1].is_valid() && u == opposite[1]) m_.region(f) = region[1];
+      }
+    }
+  }
+  ++report_.splits;
+  mark_ring(v);
+  return true;
+}
+
+// Whether collapsing h (its from-vertex v0 onto its to-vertex v1) keeps features, topology and
+// geometry; min_quality receives the worst new triangle.
+bool Remesher::collapse_check(HalfedgeHandle h, double& min_quality) const {
+  auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
+  auto e = m_.edge_handle(h);
+  char kind = m_.property(kind_, v0);
+  if (kind == kLockedVertex) return false;
+  if (kind == kCurveVertex && m_.property(ecurve_, e) != m_.property(vcurve_, v0)) return false;
+  if (kind == kFreeVertex && m_.property(ecurve_, e) != kNoCurve) return false;
+  // Two feature edges of a triangle cannot be merged into one.
+  for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
+    if (m_.is_boundary(hh)) continue;
+    auto vl = m_.to_vertex_handle(m_.next_halfedge_handle(hh));
+    auto e0 = m_.edge_handle(m_.find_halfedge(v0, vl)), e1 = m_.edge_handle(m_.find_halfedge(v1, vl));
+    if (m_.property(ecurve_, e0) != kNoCurve && m_.property(ecurve_, e1) != kNoCurve) return false;
+  }
+  if (!const_cast<SurfaceMesh&>(m_).is_collapse_ok(h)) return false;
+  const Vec3& p1 = m_.point(v1);
+  double old_min = 1, new_min = 1;
+  for (auto f : m_.vf_range(v0)) {
+    auto pts = face_points(m_, f);
+    auto old_tri = triangle(pts[0], pts[1], pts[2]);
+    old_min = std::min(old_min, old_tri.quality);
+    bool has_v1 = false;
+    for (auto u : m_.fv_range(f)) has_v1 |= u == v1;
+    if (has_v1) continue;
+    auto vs = face_vertices(m_, f);
+    for (int k = 0; k < 3; ++k)
+      if (vs[k] == v0) pts[k] = p1;
+    auto t = triangle(pts[0], pts[1], pts[2]);
+    Vec3 n_old = old_tri.quality > 1e-3 ? old_tri.normal : m_.property(vnormal_, v0);
+    if ((t.normal | n_old) < 0.7) return false;
+    new_min = std::min(new_min, t.quality);
+  }
+  if (new_min < std::min(kAcceptQuality, old_min)) return false;
+  for (auto w : m_.vv_range(v0)) {
+    if (w == v1) continue;
+    if ((m_.point(w) - p1).norm() > kSplitRatio * target(v1, w)) return false;
+  }
+  min_quality = new_min;
+  return true;
+}
+
+bool Remesher::collapse(EdgeHandle e) {
+  auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+  double q0 = -1, q1 = -1;
+  bool ok0 = collapse_check(h0, q0), ok1 = collapse_check(h1, q1);
+  if (!ok0 && !ok1) return false;
+  auto h = (ok0 && (!ok1 || q0 >= q1)) ? h0 : h1;
+  auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
+  // The edges (v0, vl) and (v1, vl) of each removed triangle merge: keep the union of their tags.
+  struct Merge {
+    VertexHandle vl;
+    bool interface, ridge, required;
+    int ref;
+    char curve;
+  };
+  std::vector<Merge> merges;
+  for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
+    if (m_.is_boundary(hh)) continue;
+    auto vl = m_.to_vertex_handle(m_.next_halfedge_handle(hh));
+    auto e0 = m_.edge_handle(m_.find_halfedge(v0, vl)), e1 = m_.edge_handle(m_.find_halfedge(v1, vl));
+    merges.push_back({vl, m_.interface(e0) || m_.interface(e1), m_.ridge(e0) || m_.ridge(e1),
+                      m_.required(e0) || m_.required(e1), std::max(m_.edge_ref(e0), m_.edge_ref(e1)),
+                      std::max(m_.property(ecurve_, e0), m_.property(ecurve_, e1))});
+  }
+  m_.collapse(h);
+  for (const auto& mg : merges) {
+    auto hh = m_.find_halfedge(v1, mg.vl);
+    if (!hh.is_valid()) continue;
+    auto ee = m_.edge_handle(hh);
+    m_.interface(ee) = mg.interface;
+    m_.ridge(ee) = mg.ridge;
+    m_.required(ee) = mg.required;
+    m_.edge_ref(ee) = mg.ref;
+    m_.property(ecurve_, ee) = mg.curve;
+  }
+  ++report_.collapses;
+  mark_ring(v1);
+  return true;
+}
+
+bool Remesher::flip(EdgeHandle e) {
+  if (m_.property(ecurve_, e) != kNoCurve || m_.is_boundary(e)) return false;
+  if (!m_.is_flip_ok(e)) return false;
+  auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+  auto a = m_.from_vertex_handle(h0), b = m_.to_vertex_handle(h0);
+  auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h0));
+  auto d = m_.to_vertex_handle(m_.next_halfedge_handle(h1));
+  const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
+  double q_old = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+  auto t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
+  double q_new = std::min(t0.quality, t1.quality);
+  // Only pairs with a poor triangle are worth changing: a good mesh stays as it is.
+  if (q_old >= kFlipBelow || q_new <= q_old + 1e-3) return false;
+  // The new pair must lie flat on S (no fold, no shortcut across curvature).
+  Vec3 n = m_.property(vnormal_, a) + m_.property(vnormal_, b) + m_.property(vnormal_, c) + m_.property(vnormal_, d);
+  double len = n.norm();
+  if (len <= 0) return false;
+  n /= len;
+  constexpr double kCos20 = 0.9396926207859084;
+  if ((t0.normal | n) < kCos20 || (t1.normal | n) < kCos20) return false;
+  m_.flip(e);
+  ++report_.flips;
+  for (auto v : {a, b, c, d}) mark_fresh(v);
+  return true;
+}
+
+double Remesher::relocate(VertexHandle v) {
+  char kind = m_.property(kind_, v);
+  if (kind == kLockedVertex || m_.is_isolated(v)) return 0;
+  const Vec3 p = m_.point(v);
+  Vec3 target(0, 0, 0);
+  if (kind == kFreeVertex) {
+    int n = 0;
+    for (auto w : m_.vv_range(v)) {
+      target += m_.point(w);
+      ++n;
+    }
+    target /= double(n);
+    const Vec3& nv = m_.property(vnormal_, v);
+    Vec3 d = target - p;
+    target = p + d - nv * (d | nv);
+  } else {
+    char curve = m_.property(vcurve_, v);
+    int n = 0;
+    for (auto h : m_.voh_range(v))
+      if (m_.property(ecurve_, m_.edge_handle(h)) == curve) {
+        target += m_.point(m_.to_vertex_handle(h));
+        ++n;
+      }
+    if (n != 2) return 0;
+    target = project_on_curve(target / 2.0, curve);
+  }
+  SurfacePoint sp = ref_->closest(target, m_.property(hint_, v));
+  Vec3 q = (kind == kCurveVertex && m_.property(vcurve_, v) == kBoundaryCurve && !ref_->analytic()) ? target : sp.point;
+  double moved = (q - p).norm();
+  if (moved < 1e-3 * m_.property(size_, v)) return 0;
+  double old_min = 1, new_min = 1, old_sum = 0, new_sum = 0;
+  for (auto f : m_.vf_range(v)) {
+    auto pts = face_points(m_, f);
+    auto old_tri = triangle(pts[0], pts[1], pts[2]);
+    auto vs = face_vertices(m_, f);
+    for (int k = 0; k < 3; ++k)
+      if (vs[k] == v) pts[k] = q;
+    auto t = triangle(pts[0], pts[1], pts[2]);
+    Vec3 n_old = old_tri.quality > 1e-3 ? old_tri.normal : sp.normal;
+    if ((t.normal | n_old) < 0.7) return 0;
+    old_min = std::min(old_min, old_tri.quality);
+    new_min = std::min(new_min, t.quality);
+    old_sum += old_tri.quality;
+    new_sum += t.quality;
+  }
+  bool better = new_min >= old_min || (new_min >= 0.6 && new_sum > old_sum);
+  if (!better) return 0;
+  m_.set_point(v, q);
+  m_.property(hint_, v) = sp.face;
+  m_.property(vnormal_, v) = sp.normal;
+  ++report_.relocations;
+  return moved;
+}
+
+RemeshReport Remesher::run() {
   auto start = std::chrono::steady_clock::now();
+  setup_sizes();
+  ref_ = opt_.reference ? opt_.reference : std::make_shared<const ReferenceSurface>(m_);
+  auto stamp = [&](const char* what) {
+    if (std::getenv("BODYFIT_REMESH_DEBUG"))
+      std::fprintf(stderr, "remesh %-10s %8.1f ms work %zu\n", what,
+                   std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count(), work_.size());
+  };
+  classify_features();
+  stamp("features");
+  compute_sizing();
+  stamp("sizing");
+  seed_work();
+  stamp("seed");
+
+  for (int pass = 0; pass < opt_.max_passes && !work_.empty(); ++pass) {
+    report_.passes = pass + 1;
+    for (auto v : next_) m_.property(in_next_, v) = 0;
+    next_.clear();
+    std::size_t ops = report_.splits + report_.collapses + report_.flips;
+
+    // Split the long edges, longest first.
+    {
+      std::vector<std::pair<double, EdgeHandle>> longs;
+      for (auto e : work_edges()) {
+        auto h = m_.halfedge_handle(e, 0);
+        double l = length(e), t = target(m_.from_vertex_handle(h), m_.to_vertex_handle(h));
+        if (l > kSplitRatio * t) longs.emplace_back(l / t, e);
+      }
+      std::sort(longs.begin(), longs.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+      for (auto& [r, e] : longs) split(e);
+    }
+    // Collapse the short edges, shortest first.
+    {
+      std::vector<std::pair<double, EdgeHandle>> shorts;
+      for (auto e : work_edges()) {
+        auto h = m_.halfedge_handle(e, 0);
+        double l = length(e), t = target(m_.from_vertex_handle(h), m_.to_vertex_handle(h));
+        if (l < kCollapseRatio * t) shorts.emplace_back(l / t, e);
+      }
+      std::sort(shorts.begin(), shorts.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      for (auto& [r, e] : shorts) {
+        if (m_.status(e).deleted()) continue;
+        auto h = m_.halfedge_handle(e, 0);
+        if (length(e) >= kCollapseRatio * target(m_.from_vertex_handle(h), m_.to_vertex_handle(h))) continue;
+        collapse(e);
+      }
+    }
+    // Flip towards better triangles.
+    for (auto e : work_edges())
+      if (!m_.status(e).deleted()) flip(e);
+    // Relocate: tangential smoothing, then projection onto S (or the curve).
+    bool moved = false;
+    std::vector<VertexHandle> to_smooth = work_;
+    for (auto v : to_smooth) {
+      if (m_.status(v).deleted()) continue;
+      double d = relocate(v);
+      if (d > 0.02 * m_.property(size_, v)) {
+        moved = true;
+        char depth = m_.property(depth_, v);
+        if (depth < kSmoothRings) {
+          mark(v);
+          for (auto w : m_.vv_range(v)) {
+            if (!m_.property(in_next_, w) && !m_.property(in_work_, w)) m_.property(depth_, w) = char(depth + 1);
+            else m_.property(depth_, w) = std::min(m_.property(depth_, w), char(depth + 1));
+            mark(w);
+          }
+        }
+      }
+    }
+    stamp("pass");
+    if (std::getenv("BODYFIT_REMESH_DEBUG"))
+      std::fprintf(stderr, "  splits %zu collapses %zu flips %zu moves %zu\n", report_.splits, report_.collapses, report_.flips, report_.relocations);
+    bool changed = report_.splits + report_.collapses + report_.flips > ops;
+    for (auto v : work_) m_.property(in_work_, v) = 0;
+    work_.clear();
+    if (!changed && !moved) break;
+    for (auto v : next_) {
+      if (m_.status(v).deleted()) continue;
+      m_.property(in_work_, v) = 1;
+      work_.push_back(v);
+    }
+  }
+  for (auto v : work_) m_.property(in_work_, v) = 0;
+  for (auto v : next_) m_.property(in_next_, v) = 0;
+
+  m_.garbage_collection();
+  stamp("gc");
+  auto q = quality_stats(m_);
+  report_.min_quality = q.min;
+  report_.mean_quality = q.mean;
+  report_.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return report_;
+}
+
+}  // namespace
+
+RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions& options) {
   mesh.garbage_collection();
-  RemeshReport report;
-  auto q = quality_stats(mesh);
-  report.min_quality = q.min;
-  report.mean_quality = q.mean;
-  report.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return report;
+  Remesher remesher(mesh, options);
+  return remesher.run();
 }
 
 }  // namespace bodyfit

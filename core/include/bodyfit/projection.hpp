@@ -1,0 +1,84 @@
+#pragma once
+// Projection onto fixed reference geometry: the input surface S (closest point on a triangle soup,
+// or an exact sphere) and reference polylines (the input's interface curve, ridges, boundary).
+// The remesher projects every new or moved vertex so that neither S nor the interface drifts.
+#include <bodyfit/mesh.hpp>
+
+#include <memory>
+#include <mutex>
+#include <vector>
+
+namespace bodyfit {
+
+namespace detail {
+/// Bounding-volume hierarchy over boxes (private layout shared by the two projections).
+struct BoxTree {
+  struct Node {
+    Vec3 lo, hi;
+    int left = -1, right = -1;  ///< children; -1 for a leaf
+    int begin = 0, end = 0;     ///< leaf range in `order`
+  };
+  std::vector<Node> nodes;
+  std::vector<int> order;  ///< primitive indices, leaves hold contiguous ranges
+  void build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
+};
+}  // namespace detail
+
+/// A point of S: position, unit normal of S there and the reference triangle (-1 when analytic).
+struct SurfacePoint {
+  Vec3 point{0, 0, 0};
+  Vec3 normal{0, 0, 0};
+  int face = -1;
+};
+
+class ReferenceSurface {
+ public:
+  /// Copy the triangles of `mesh` (non-deleted faces; face i of a garbage-collected mesh is
+  /// reference triangle i). The search tree is built on the first query.
+  explicit ReferenceSurface(const SurfaceMesh& mesh);
+  /// Exact sphere: the projection is c + r (p − c)/|p − c|.
+  static std::shared_ptr<ReferenceSurface> sphere(const Vec3& center, double radius);
+
+  /// Closest point of S to p. `hint` (a reference triangle near p, or -1) speeds up the search.
+  SurfacePoint closest(const Vec3& p, int hint = -1) const;
+  bool analytic() const { return is_sphere_; }
+  /// Radius of the analytic sphere (0 for a triangle reference).
+  double sphere_radius() const { return is_sphere_ ? radius_ : 0.0; }
+  std::size_t n_triangles() const { return tri_.size(); }
+
+ private:
+  ReferenceSurface() = default;
+  void ensure_tree() const;
+  bool is_sphere_ = false;
+  Vec3 center_{0, 0, 0};
+  double radius_ = 1;
+  std::vector<Vec3> points_;
+  std::vector<std::array<int, 3>> tri_;
+  std::vector<Vec3> normal_;
+  mutable std::once_flag tree_once_;
+  mutable detail::BoxTree tree_;
+};
+
+/// A set of segments, each with an integer label (e.g. the kind of curve); closest point among the
+/// segments carrying a given label.
+class ReferencePolyline {
+ public:
+  void add(const Vec3& a, const Vec3& b, int label);
+  /// Closest point to p on the segments with `label`; returns p when there is none.
+  Vec3 closest(const Vec3& p, int label) const;
+  std::size_t size() const { return a_.size(); }
+
+ private:
+  void ensure_tree() const;
+  std::vector<Vec3> a_, b_;
+  std::vector<int> label_;
+  mutable bool built_ = false;
+  mutable detail::BoxTree tree_;
+};
+
+/// Closest point to p on the triangle abc.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+/// Closest point to p on the segment ab.
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b);
+
+}  // namespace bodyfit

@@ -1,0 +1,242 @@
+#include <bodyfit/projection.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace bodyfit {
+
+namespace detail {
+
+namespace {
+constexpr int kLeafSize = 4;
+
+struct Builder {
+  const std::vector<Vec3>& lo;
+  const std::vector<Vec3>& hi;
+  BoxTree& tree;
+
+  int build(int begin, int end) {
+    int id = int(tree.nodes.size());
+    tree.nodes.emplace_back();
+    Vec3 nlo(std::numeric_limits<double>::max()), nhi(-std::numeric_limits<double>::max());
+    Vec3 clo = nlo, chi = nhi;  // bounds of the box centres
+    for (int i = begin; i < end; ++i) {
+      int p = tree.order[i];
+      nlo.minimize(lo[p]);
+      nhi.maximize(hi[p]);
+      Vec3 c = (lo[p] + hi[p]) * 0.5;
+      clo.minimize(c);
+      chi.maximize(c);
+    }
+    tree.nodes[id].lo = nlo;
+    tree.nodes[id].hi = nhi;
+    if (end - begin <= kLeafSize) {
+      tree.nodes[id].begin = begin;
+      tree.nodes[id].end = end;
+      return id;
+    }
+    Vec3 ext = chi - clo;
+    int axis = ext[0] > ext[1] ? (ext[0] > ext[2] ? 0 : 2) : (ext[1] > ext[2] ? 1 : 2);
+    int mid = (begin + end) / 2;
+    std::nth_element(tree.order.begin() + begin, tree.order.begin() + mid, tree.order.begin() + end,
+                     [&](int a, int b) { return lo[a][axis] + hi[a][axis] < lo[b][axis] + hi[b][axis]; });
+    int left = build(begin, mid);
+    int right = build(mid, end);
+    tree.nodes[id].left = left;
+    tree.nodes[id].right = right;
+    return id;
+  }
+};
+
+double box_distance2(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    double d = std::max({lo[k] - p[k], 0.0, p[k] - hi[k]});
+    d2 += d * d;
+  }
+  return d2;
+}
+
+/// Nearest primitive by depth-first traversal, nearer child first; `distance2(i)` gives the
+/// squared distance to primitive i and records the best candidate itself.
+template <class Distance>
+void nearest(const BoxTree& tree, const Vec3& p, double& best2, Distance&& distance2) {
+  if (tree.nodes.empty()) return;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const auto& node = tree.nodes[stack[--top]];
+    if (box_distance2(p, node.lo, node.hi) >= best2) continue;
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) distance2(tree.order[i]);
+      continue;
+    }
+    double dl = box_distance2(p, tree.nodes[node.left].lo, tree.nodes[node.left].hi);
+    double dr = box_distance2(p, tree.nodes[node.right].lo, tree.nodes[node.right].hi);
+    if (dl < dr) {
+      if (dr < best2) stack[top++] = node.right;
+      stack[top++] = node.left;
+    } else {
+      if (dl < best2) stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+}
+}  // namespace
+
+void BoxTree::build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
+  nodes.clear();
+  order.resize(lo.size());
+  std::iota(order.begin(), order.end(), 0);
+  if (lo.empty()) return;
+  nodes.reserve(2 * lo.size() / kLeafSize + 2);
+  Builder{lo, hi, *this}.build(0, int(lo.size()));
+}
+
+}  // namespace detail
+
+Vec3 closest_point_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  Vec3 ab = b - a;
+  double len2 = ab.sqrnorm();
+  if (len2 <= 0) return a;
+  double t = std::clamp(((p - a) | ab) / len2, 0.0, 1.0);
+  return a + ab * t;
+}
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Voronoi regions of the vertices, edges and face (Ericson, Real-Time Collision Detection 5.1.5).
+  Vec3 ab = b - a, ac = c - a, ap = p - a;
+  double d1 = ab | ap, d2 = ac | ap;
+  if (d1 <= 0 && d2 <= 0) return a;
+  Vec3 bp = p - b;
+  double d3 = ab | bp, d4 = ac | bp;
+  if (d3 >= 0 && d4 <= d3) return b;
+  double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  Vec3 cp = p - c;
+  double d5 = ab | cp, d6 = ac | cp;
+  if (d6 >= 0 && d5 <= d6) return c;
+  double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  double denom = va + vb + vc;
+  if (denom == 0) return a;
+  double v = vb / denom, w = vc / denom;
+  return a + ab * v + ac * w;
+}
+
+ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
+  std::vector<int> index(mesh.n_vertices(), -1);
+  for (auto v : mesh.vertices()) {
+    index[v.idx()] = int(points_.size());
+    points_.push_back(mesh.point(v));
+  }
+  for (auto f : mesh.faces()) {
+    std::array<int, 3> t{};
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) t[k++] = index[v.idx()];
+    tri_.push_back(t);
+    Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);
+    double len = n.norm();
+    normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
+  }
+}
+
+std::shared_ptr<ReferenceSurface> ReferenceSurface::sphere(const Vec3& center, double radius) {
+  std::shared_ptr<ReferenceSurface> s(new ReferenceSurface());
+  s->is_sphere_ = true;
+  s->center_ = center;
+  s->radius_ = radius;
+  return s;
+}
+
+void ReferenceSurface::ensure_tree() const {
+  std::call_once(tree_once_, [this] {
+    std::vector<Vec3> lo(tri_.size()), hi(tri_.size());
+    for (std::size_t i = 0; i < tri_.size(); ++i) {
+      lo[i] = hi[i] = points_[tri_[i][0]];
+      for (int k = 1; k < 3; ++k) {
+        lo[i].minimize(points_[tri_[i][k]]);
+        hi[i].maximize(points_[tri_[i][k]]);
+      }
+    }
+    tree_.build(lo, hi);
+  });
+}
+
+SurfacePoint ReferenceSurface::closest(const Vec3& p, int hint) const {
+  SurfacePoint out;
+  if (is_sphere_) {
+    Vec3 d = p - center_;
+    double len = d.norm();
+    out.normal = len > 0 ? d / len : Vec3(0, 0, 1);
+    out.point = center_ + out.normal * radius_;
+    return out;
+  }
+  if (tri_.empty()) {
+    out.point = p;
+    return out;
+  }
+  double best2 = std::numeric_limits<double>::max();
+  auto consider = [&](int i) {
+    const auto& t = tri_[i];
+    Vec3 q = closest_point_on_triangle(p, points_[t[0]], points_[t[1]], points_[t[2]]);
+    double d2 = (q - p).sqrnorm();
+    if (d2 < best2) {
+      best2 = d2;
+      out.point = q;
+      out.face = i;
+    }
+  };
+  if (hint >= 0 && hint < int(tri_.size())) {
+    consider(hint);
+    best2 *= 1 + 1e-12;  // keep the hint's value as a strict bound
+  }
+  ensure_tree();
+  detail::nearest(tree_, p, best2, consider);
+  out.normal = normal_[out.face];
+  return out;
+}
+
+void ReferencePolyline::add(const Vec3& a, const Vec3& b, int label) {
+  a_.push_back(a);
+  b_.push_back(b);
+  label_.push_back(label);
+  built_ = false;
+}
+
+void ReferencePolyline::ensure_tree() const {
+  if (built_) return;
+  std::vector<Vec3> lo(a_.size()), hi(a_.size());
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    lo[i] = a_[i];
+    lo[i].minimize(b_[i]);
+    hi[i] = a_[i];
+    hi[i].maximize(b_[i]);
+  }
+  tree_.build(lo, hi);
+  built_ = true;
+}
+
+Vec3 ReferencePolyline::closest(const Vec3& p, int label) const {
+  ensure_tree();
+  double best2 = std::numeric_limits<double>::max();
+  Vec3 best = p;
+  detail::nearest(tree_, p, best2, [&](int i) {
+    if (label_[i] != label) return;
+    Vec3 q = closest_point_on_segment(p, a_[i], b_[i]);
+    double d2 = (q - p).sqrnorm();
+    if (d2 < best2) {
+      best2 = d2;
+      best = q;
+    }
+  });
+  return best;
+}
+
+}  // namespace bodyfit
