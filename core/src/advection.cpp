@@ -187,10 +187,13 @@ WalkEnd walk(const Surface& s, Location& at, V3 d, M3* rotation) {
     const Face& f = s.faces[at.face];
     const double db[3] = {dot(f.grad[0], d), dot(f.grad[1], d), dot(f.grad[2], d)};
     // Coordinates reaching zero before the end of the displacement (b_i + db_i < 0). Most calls
-    // end in the face they start in, and this test needs no division.
-    const bool reaches[3] = {at.b[0] + db[0] < 0, at.b[1] + db[1] < 0, at.b[2] + db[2] < 0};
+    // end in the face they start in, and this test needs no division. An overshoot below the
+    // rounding level is not a crossing: a path running along an edge (a boundary edge in
+    // particular) stays on it instead of stepping out through rounding noise.
+    constexpr double overshoot = -1e-13;
+    const bool reaches[3] = {at.b[0] + db[0] < overshoot, at.b[1] + db[1] < overshoot, at.b[2] + db[2] < overshoot};
     if (!reaches[0] && !reaches[1] && !reaches[2]) {  // stays in this face
-      for (int i = 0; i < 3; ++i) at.b[i] += db[i];
+      for (int i = 0; i < 3; ++i) at.b[i] = std::max(at.b[i] + db[i], 0.0);
       return WalkEnd::arrived;
     }
     // First edge reached: the smallest t with b_i + t db_i = 0.
