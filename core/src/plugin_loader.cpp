@@ -72,6 +72,19 @@ std::vector<fs::path> plugin_files(const fs::path& dir) {
   return files;
 }
 
+/// The plugin directory next to the libbodyfit_core actually loaded (<libdir>/bodyfit/plugins):
+/// the build tree and any install prefix share this layout, so an installed tree that was moved
+/// or installed with `cmake --install --prefix` still finds its own plugins.
+fs::path plugin_dir_beside_core() {
+  static const char anchor = 0;
+  Dl_info info;
+  if (!dladdr(&anchor, &info) || !info.dli_fname) return {};
+  std::error_code ec;
+  fs::path library = fs::weakly_canonical(fs::path(info.dli_fname), ec);
+  if (ec) return {};
+  return library.parent_path() / "bodyfit" / "plugins";
+}
+
 }  // namespace
 
 std::string abi_string(std::uint32_t abi) { return fmt::format("{}.{}", abi >> 16, abi & 0xffffu); }
@@ -113,7 +126,10 @@ void LoadedModel::reset() {
 std::vector<fs::path> plugin_search_path() {
   std::vector<fs::path> dirs;
   auto add = [&](const fs::path& dir) {
-    if (!dir.empty() && std::find(dirs.begin(), dirs.end(), dir) == dirs.end()) dirs.push_back(dir);
+    if (dir.empty()) return;
+    std::error_code ec;
+    auto same = [&](const fs::path& other) { return other == dir || fs::equivalent(other, dir, ec); };
+    if (std::none_of(dirs.begin(), dirs.end(), same)) dirs.push_back(dir);
   };
   if (const char* env = std::getenv("BODYFIT_PLUGIN_PATH")) {
     std::string_view rest(env);
@@ -124,6 +140,7 @@ std::vector<fs::path> plugin_search_path() {
       rest.remove_prefix(colon + 1);
     }
   }
+  add(plugin_dir_beside_core());
   add(config::plugin_build_dir);
   add(config::plugin_install_dir);
   return dirs;

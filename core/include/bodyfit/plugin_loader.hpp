@@ -1,8 +1,10 @@
 #pragma once
 // Finding and loading velocity-model plugins (shared objects named bodyfit_<model>.so).
 //
-// Search order: the directories of BODYFIT_PLUGIN_PATH (colon-separated), the build tree's plugin
-// directory, the install prefix's plugin directory. Every failure (no such model, dlopen error,
+// Search order: the directories of BODYFIT_PLUGIN_PATH (colon-separated), the plugin directory
+// beside the loaded libbodyfit_core (<libdir>/bodyfit/plugins: the build tree's or the install
+// prefix's, wherever the tree now lives), the build tree's plugin directory, the configured
+// install prefix's plugin directory (duplicates dropped). Every failure (no such model, dlopen error,
 // missing symbol, ABI mismatch, throwing constructor) is an InputError naming the file and reason.
 // The ABI (major << 16 | minor) is checked before anything else: the major must equal ours and the
 // plugin's minor must not exceed ours (a plugin built against older headers of the same major loads).

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Out-of-tree plugin check: install the bodyfit build to a temporary prefix, build
+# examples/plugin against it with find_package(bodyfit) + bodyfit_add_plugin, then ask the
+# installed driver to list it through BODYFIT_PLUGIN_PATH.
+#   usage: out_of_tree_plugin.sh <bodyfit build dir> <bodyfit source dir>
+set -euo pipefail
+build=$(cd "$1" && pwd)
+source=$(cd "$2" && pwd)
+work=$(mktemp -d "${TMPDIR:-/tmp}/bodyfit_oot.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+
+step() { echo "== $*"; }
+fail() { echo "FAILED: $*" >&2; exit 1; }
+
+step "install $build to $work/prefix"
+cmake --install "$build" --prefix "$work/prefix" > "$work/install.log" 2>&1 || { cat "$work/install.log"; fail "cmake --install"; }
+[[ -x "$work/prefix/bin/bodyfit" ]] || fail "no bin/bodyfit in the prefix"
+config=$(find "$work/prefix" -name bodyfitConfig.cmake | head -n1)
+[[ -n "$config" ]] || fail "no bodyfitConfig.cmake in the prefix"
+
+step "configure and build examples/plugin against the prefix"
+launcher=()
+if command -v ccache > /dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake -S "$source/examples/plugin" -B "$work/plugin-build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" > "$work/configure.log" 2>&1 || { cat "$work/configure.log"; fail "configure"; }
+cmake --build "$work/plugin-build" -j2 > "$work/build.log" 2>&1 || { cat "$work/build.log"; fail "build"; }
+plugin="$work/plugin-build/bodyfit_windy.so"
+[[ -f "$plugin" ]] || fail "bodyfit_windy.so was not built at the top of the build tree"
+
+step "list it with the installed driver"
+listing=$(BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" plugins 2>&1) || { echo "$listing"; fail "bodyfit plugins"; }
+echo "$listing"
+grep -q "^windy 1.0  (ABI 1.0)" <<< "$listing" || fail "windy not listed"
+grep -qF "file: $plugin" <<< "$listing" || fail "windy not listed with its file"
+grep -qF "wind = [1, 0, 0]" <<< "$listing" || fail "windy's parameters not listed"
+# The installed driver finds the installed conormal plugin beside its own library.
+grep -qF "$work/prefix/" <<< "$(grep -A1 '^conormal ' <<< "$listing")" || fail "installed conormal plugin not found in the prefix"
+grep -q "failed to load" <<< "$listing" && fail "some plugin failed to load"
+
+step "install the example plugin into the prefix: found without BODYFIT_PLUGIN_PATH"
+cmake --install "$work/plugin-build" --prefix "$work/prefix" > "$work/install-plugin.log" 2>&1 || { cat "$work/install-plugin.log"; fail "plugin install"; }
+listing=$(env -u BODYFIT_PLUGIN_PATH "$work/prefix/bin/bodyfit" plugins 2>&1) || { echo "$listing"; fail "bodyfit plugins"; }
+grep -A1 "^windy " <<< "$listing" | grep -qF "$work/prefix/" || { echo "$listing"; fail "installed windy not found"; }
+
+echo "out-of-tree plugin: OK"
