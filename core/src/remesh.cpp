@@ -23,9 +23,10 @@ constexpr char kNoCurve = 0, kInterfaceCurve = 1, kRidgeCurve = 2, kBoundaryCurv
 // Vertex kinds: free on S, sliding along one feature curve, locked.
 constexpr char kFreeVertex = 0, kCurveVertex = 1, kLockedVertex = 2;
 
-// Botsch–Kobbelt thresholds relative to the target size: split above 4/3, collapse below 4/5.
-constexpr double kSplitRatio = 4.0 / 3.0;
-constexpr double kCollapseRatio = 4.0 / 5.0;
+// Edge length window relative to the target size (as MMG's metric lengths): split above √2,
+// collapse below 1/√2, so that a mesh whose edges are within ±30 % of the target is left alone.
+constexpr double kSplitRatio = 1.41;
+constexpr double kCollapseRatio = 0.71;
 // Faces of quality below this start the work queue (a geodesic sphere is ≥ 0.7 everywhere).
 constexpr double kGoodQuality = 0.6;
 // A collapse may create triangles down to this quality (never below the worst one it removes).
@@ -161,10 +162,6 @@ void Remesher::classify_features() {
     else if (m_.ridge(e)) c = kRidgeCurve;
     else if (m_.is_boundary(e)) c = kBoundaryCurve;
     m_.property(ecurve_, e) = c;
-    if (c != kNoCurve && c != kRequiredCurve) {
-      auto h = m_.halfedge_handle(e, 0);
-      curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), c);
-    }
   }
   for (auto v : m_.vertices()) {
     int count = 0;
@@ -196,6 +193,24 @@ void Remesher::classify_features() {
     if (!opt_.reference)
       for (auto f : m_.vf_range(v)) hint = f.idx();
     m_.property(hint_, v) = hint;
+  }
+  // Cut points lie on chords of S: put the interface on S before it becomes the reference curve
+  // (a no-op when S is the input mesh itself).
+  if (opt_.reference)
+    for (auto e : m_.edges())
+      if (m_.property(ecurve_, e) == kInterfaceCurve)
+        for (auto v : {m_.from_vertex_handle(m_.halfedge_handle(e, 0)), m_.to_vertex_handle(m_.halfedge_handle(e, 0))})
+          if (!m_.required(v) && !m_.corner(v)) {
+            auto sp = ref_->closest(m_.point(v), m_.property(hint_, v));
+            m_.set_point(v, sp.point);
+            m_.property(hint_, v) = sp.face;
+          }
+  for (auto e : m_.edges()) {
+    char c = m_.property(ecurve_, e);
+    if (c != kNoCurve && c != kRequiredCurve) {
+      auto h = m_.halfedge_handle(e, 0);
+      curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), c);
+    }
   }
 }
 

@@ -1,0 +1,316 @@
+// Remeshing keeps the surface, the interface, the features, the boundary and the topology, and
+// leaves an already-good mesh alone. Exact references: the unit sphere, a cube, a plane square.
+#include <doctest/doctest.h>
+
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/projection.hpp>
+#include <bodyfit/remesh.hpp>
+#include <bodyfit/validate.hpp>
+
+#include <cmath>
+#include <map>
+#include <random>
+
+using namespace bodyfit;
+
+namespace {
+
+double beta(const Vec3& p) { return std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0)); }
+
+/// Square [0, side]² in the plane z = 0 (or on a gentle height field), n × n cells, two triangles each.
+SurfaceMesh make_grid(int n, double side, bool curved = false) {
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> vh;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      double x = side * i / n, y = side * j / n;
+      double z = curved ? 0.05 * side * std::sin(3 * x / side) * std::cos(2 * y / side) : 0.0;
+      vh.push_back(mesh.add_vertex(Vec3(x, y, z)));
+    }
+  auto id = [&](int i, int j) { return vh[std::size_t(j) * (n + 1) + i]; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      mesh.add_face(id(i, j), id(i + 1, j), id(i + 1, j + 1));
+      mesh.add_face(id(i, j), id(i + 1, j + 1), id(i, j + 1));
+    }
+  for (auto f : mesh.faces()) mesh.region(f) = kOutside;
+  return mesh;
+}
+
+/// Cube [-1, 1]³, each side an n × n grid of cells with alternating diagonals, outward normals.
+SurfaceMesh make_cube(int n) {
+  SurfaceMesh mesh;
+  std::map<std::array<long, 3>, VertexHandle> index;
+  auto vertex = [&](const Vec3& p) -> VertexHandle {
+    std::array<long, 3> key{std::lround(p[0] * n * 4), std::lround(p[1] * n * 4), std::lround(p[2] * n * 4)};
+    auto it = index.find(key);
+    if (it != index.end()) return it->second;
+    auto v = mesh.add_vertex(p);
+    index[key] = v;
+    return v;
+  };
+  for (int axis = 0; axis < 3; ++axis)
+    for (int sign = -1; sign <= 1; sign += 2) {
+      int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      auto point = [&](int i, int j) {
+        Vec3 p(0, 0, 0);
+        p[axis] = sign;
+        p[u] = -1 + 2.0 * i / n;
+        p[w] = -1 + 2.0 * j / n;
+        return vertex(p);
+      };
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          auto a = point(i, j), b = point(i + 1, j), c = point(i + 1, j + 1), d = point(i, j + 1);
+          // (u, w, axis) is right-handed, so a→b→c faces +axis; flip for the negative side.
+          if (sign > 0) {
+            mesh.add_face(a, b, c);
+            mesh.add_face(a, c, d);
+          } else {
+            mesh.add_face(a, c, b);
+            mesh.add_face(a, d, c);
+          }
+        }
+    }
+  for (auto f : mesh.faces()) mesh.region(f) = kOutside;
+  return mesh;
+}
+
+ScalarField cap_phi(const SurfaceMesh& mesh, double radius) {
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) phi[v.idx()] = beta(mesh.point(v)) - radius;
+  return phi;
+}
+
+std::string problems(const SurfaceMesh& mesh, ValidateOptions options = {}) {
+  auto report = validate_mesh(mesh, options);
+  return report.ok() ? std::string() : report.summary();
+}
+
+}  // namespace
+
+TEST_CASE("sphere cap: topology, regions, quality, surface and interface accuracy") {
+  auto mesh = make_sphere({.faces = 5120});
+  double h = edge_length_stats(mesh).mean;
+  double radius = M_PI / 4;
+  DiscretizeOptions cut;
+  cut.snap_ratio = 0;
+  discretize(mesh, cap_phi(mesh, radius), cut);
+  RemeshOptions options;
+  options.hmax = h;
+  options.reference = ReferenceSurface::sphere(Vec3(0, 0, 0), 1);
+  auto report = remesh(mesh, options);
+
+  ValidateOptions vo;
+  vo.euler_characteristic = 2;
+  vo.boundary_loops = 0;
+  CHECK(problems(mesh, vo) == "");
+  CHECK(connected_components(mesh) == 1);
+  CHECK(region_components(mesh, kInside) == 1);
+  CHECK(region_components(mesh, kOutside) == 1);
+  auto curves = interface_curves(mesh);
+  CHECK(curves.closed == 1);
+  CHECK(curves.open == 0);
+  // Cap area 2π(1 − cos a) and its circle length 2π sin a, to O(h²).
+  double cap = 2 * M_PI * (1 - std::cos(radius));
+  CHECK(std::abs(region_area(mesh, kInside) - cap) < 0.5 * h * h * 4 * M_PI / 4);
+  CHECK(std::abs(interface_length(mesh) - 2 * M_PI * std::sin(radius)) < 2 * M_PI * h * h);
+  // Quality.
+  CHECK(report.min_quality >= 0.5);
+  CHECK(report.mean_quality >= 0.95);
+  // Every vertex exactly on S; every edge midpoint within hausd (default D/1000).
+  double hausd = 2 * std::sqrt(3.0) / 1000;
+  for (auto v : mesh.vertices()) CHECK(std::abs(mesh.point(v).norm() - 1) < 1e-12);
+  double worst_mid = 0;
+  for (auto e : mesh.edges()) {
+    auto hh = mesh.halfedge_handle(e, 0);
+    Vec3 mid = (mesh.point(mesh.from_vertex_handle(hh)) + mesh.point(mesh.to_vertex_handle(hh))) * 0.5;
+    worst_mid = std::max(worst_mid, 1 - mid.norm());
+  }
+  CHECK(worst_mid <= hausd);
+  // Interface vertices on the circle to the accuracy of the linear cut, O(h²).
+  for (auto e : mesh.edges())
+    if (mesh.interface(e))
+      for (auto v : {mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)), mesh.to_vertex_handle(mesh.halfedge_handle(e, 0))})
+        CHECK(std::abs(beta(mesh.point(v)) - radius) < h * h);
+}
+
+TEST_CASE("interface vertices stay on the input interface polyline, regions keep their labels") {
+  auto mesh = make_grid(30, 1.0, true);
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    auto p = mesh.point(v);
+    phi[v.idx()] = std::hypot(p[0] - 0.5, p[1] - 0.45) - 0.27;
+  }
+  DiscretizeOptions cut;
+  cut.snap_ratio = 0;
+  discretize(mesh, phi, cut);
+  ReferencePolyline input_curve;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e)) {
+      auto hh = mesh.halfedge_handle(e, 0);
+      input_curve.add(mesh.point(mesh.from_vertex_handle(hh)), mesh.point(mesh.to_vertex_handle(hh)), 0);
+    }
+  double inside_before = region_area(mesh, kInside), outside_before = region_area(mesh, kOutside);
+  RemeshOptions options;
+  options.hmax = 1.0 / 20;  // coarser than the input: forces collapses along the curve
+  auto reference = std::make_shared<ReferenceSurface>(mesh);
+  options.reference = reference;
+  auto report = remesh(mesh, options);
+  CHECK(report.collapses > 0);
+  ValidateOptions vo;
+  vo.euler_characteristic = 1;
+  vo.boundary_loops = 1;
+  CHECK(problems(mesh, vo) == "");
+  std::size_t on_curve = 0;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e))
+      for (auto v : {mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)), mesh.to_vertex_handle(mesh.halfedge_handle(e, 0))}) {
+        Vec3 p = mesh.point(v);
+        CHECK((input_curve.closest(p, 0) - p).norm() < 1e-9);
+        ++on_curve;
+      }
+  CHECK(on_curve > 0);
+  // Every vertex on the input surface.
+  for (auto v : mesh.vertices()) CHECK((reference->closest(mesh.point(v)).point - mesh.point(v)).norm() < 1e-9);
+  // Region areas change only by the chords of the coarser interface: O(h²) per unit length.
+  double h = options.hmax;
+  CHECK(std::abs(region_area(mesh, kInside) - inside_before) < 2 * M_PI * 0.27 * h * h);
+  CHECK(std::abs(region_area(mesh, kOutside) - outside_before) < 2 * M_PI * 0.27 * h * h);
+  CHECK(interface_curves(mesh).closed == 1);
+}
+
+TEST_CASE("cube: the 12 ridges and 8 corners survive exactly, vertices stay on the cube") {
+  auto mesh = make_cube(12);
+  RemeshOptions options;
+  options.hmax = 2.0 / 5;  // coarsen: 12 cells per side towards 5
+  auto report = remesh(mesh, options);
+  CHECK(report.collapses > 0);
+  ValidateOptions vo;
+  vo.euler_characteristic = 2;
+  CHECK(problems(mesh, vo) == "");
+  int corners = 0;
+  for (auto v : mesh.vertices()) {
+    Vec3 p = mesh.point(v);
+    double m = std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])});
+    CHECK(std::abs(m - 1) < 1e-12);
+    if (std::abs(std::abs(p[0]) - 1) < 1e-12 && std::abs(std::abs(p[1]) - 1) < 1e-12 && std::abs(std::abs(p[2]) - 1) < 1e-12)
+      ++corners;
+  }
+  CHECK(corners == 8);
+  // Edges on the cube's edges (two coordinates at ±1) are exactly the ridge edges, total length 24.
+  double ridge_length = 0, cube_edge_length = 0;
+  for (auto e : mesh.edges()) {
+    auto hh = mesh.halfedge_handle(e, 0);
+    Vec3 a = mesh.point(mesh.from_vertex_handle(hh)), b = mesh.point(mesh.to_vertex_handle(hh));
+    int shared = 0;
+    for (int k = 0; k < 3; ++k) shared += std::abs(std::abs(a[k]) - 1) < 1e-12 && std::abs(a[k] - b[k]) < 1e-12;
+    if (shared == 2) cube_edge_length += (a - b).norm();
+    if (mesh.ridge(e)) ridge_length += (a - b).norm();
+    // No edge cuts across a cube edge (its endpoints on two different sides only if along an edge).
+  }
+  CHECK(ridge_length == doctest::Approx(24).epsilon(1e-12));
+  CHECK(cube_edge_length == doctest::Approx(24).epsilon(1e-12));
+  // Flat sides: every face normal is a coordinate axis.
+  for (auto f : mesh.faces()) {
+    Vec3 n = face_normal(mesh, f);
+    double m = std::max({std::abs(n[0]), std::abs(n[1]), std::abs(n[2])});
+    CHECK(m == doctest::Approx(1).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("open surface: the boundary loop keeps its position, length and corners") {
+  auto mesh = make_grid(24, 2.0);
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) phi[v.idx()] = mesh.point(v)[0] - 0.73;  // a straight front reaching the boundary
+  discretize(mesh, phi);
+  RemeshOptions options;
+  options.hmax = 2.0 / 10;
+  remesh(mesh, options);
+  ValidateOptions vo;
+  vo.euler_characteristic = 1;
+  vo.boundary_loops = 1;
+  CHECK(problems(mesh, vo) == "");
+  auto loops = boundary_loops(mesh);
+  REQUIRE(loops.size() == 1);
+  double length = 0;
+  int corners = 0;
+  for (std::size_t i = 0; i < loops[0].size(); ++i) {
+    Vec3 a = mesh.point(loops[0][i]), b = mesh.point(loops[0][(i + 1) % loops[0].size()]);
+    length += (a - b).norm();
+    bool on_side = std::abs(a[0]) < 1e-12 || std::abs(a[0] - 2) < 1e-12 || std::abs(a[1]) < 1e-12 || std::abs(a[1] - 2) < 1e-12;
+    CHECK(on_side);
+    CHECK(std::abs(a[2]) < 1e-12);
+    corners += (std::abs(a[0]) < 1e-12 || std::abs(a[0] - 2) < 1e-12) && (std::abs(a[1]) < 1e-12 || std::abs(a[1] - 2) < 1e-12);
+  }
+  CHECK(length == doctest::Approx(8).epsilon(1e-12));
+  CHECK(corners == 4);
+  CHECK(interface_curves(mesh).open == 1);
+}
+
+TEST_CASE("an already-good mesh comes back nearly untouched") {
+  auto mesh = make_sphere({.faces = 20000});
+  auto original = mesh;
+  RemeshOptions options;
+  options.hmax = edge_length_stats(mesh).mean;
+  auto report = remesh(mesh, options);
+  CHECK(report.splits + report.collapses + report.flips == 0);
+  CHECK(report.relocations == 0);
+  REQUIRE(mesh.n_vertices() == original.n_vertices());
+  for (auto v : mesh.vertices()) CHECK((mesh.point(v) - original.point(v)).norm() == 0);
+}
+
+TEST_CASE("required vertices are never moved or removed") {
+  auto mesh = make_grid(20, 1.0, true);
+  std::vector<Vec3> required;
+  std::mt19937 rng(3);
+  for (auto v : mesh.vertices())
+    if (rng() % 17 == 0) {
+      mesh.required(v) = 1;
+      required.push_back(mesh.point(v));
+    }
+  RemeshOptions options;
+  options.hmax = 1.0 / 8;  // strong coarsening
+  auto report = remesh(mesh, options);
+  CHECK(report.collapses > 0);
+  CHECK(problems(mesh) == "");
+  std::size_t found = 0;
+  for (auto v : mesh.vertices())
+    if (mesh.required(v))
+      for (const auto& p : required) found += (mesh.point(v) - p).norm() == 0;
+  CHECK(found == required.size());
+}
+
+TEST_CASE("discretize + remesh of random level sets never produces an invalid mesh") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  for (int trial = 0; trial < 6; ++trial) {
+    SurfaceMesh mesh = trial % 3 == 0 ? make_sphere({.faces = 2000}) : trial % 3 == 1 ? make_grid(25, 1.0, true) : make_cube(8);
+    long chi = euler_characteristic(mesh);
+    std::size_t loops = boundary_loops(mesh).size();
+    // A sum of random plane waves: several components, saddles, curves touching the boundary.
+    Vec3 k[3];
+    double phase[3];
+    for (int i = 0; i < 3; ++i) {
+      k[i] = Vec3(uni(rng), uni(rng), uni(rng)) * 9.0;
+      phase[i] = 3 * uni(rng);
+    }
+    ScalarField phi(mesh.n_vertices());
+    for (auto v : mesh.vertices()) {
+      Vec3 p = mesh.point(v);
+      phi[v.idx()] = std::sin((k[0] | p) + phase[0]) + std::sin((k[1] | p) + phase[1]) + 0.5 * std::sin((k[2] | p) + phase[2]) + 0.3;
+    }
+    discretize(mesh, phi);
+    double hmax = edge_length_stats(mesh).mean * (trial < 3 ? 1.0 : 1.7);
+    RemeshOptions options;
+    options.hmax = hmax;
+    remesh(mesh, options);
+    ValidateOptions vo;
+    vo.euler_characteristic = chi;
+    vo.boundary_loops = loops;
+    INFO("trial " << trial);
+    CHECK(problems(mesh, vo) == "");
+  }
+}
