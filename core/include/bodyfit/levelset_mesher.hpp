@@ -3,24 +3,41 @@
 // paper §3.4): afterwards the interface is a chain of mesh edges tagged e:interface (ref 10), the
 // faces are labelled kInside (φ < 0) or kOutside, and v:phi holds φ (0 on the interface).
 // The result is conforming but may contain thin triangles: remesh() comes next.
+// docs/levelset_mesher.md describes the cutting patterns, the snapping rule and the degenerate cases.
 #include <bodyfit/mesh.hpp>
 
 namespace bodyfit {
 
 struct DiscretizeOptions {
-  /// A vertex whose |φ| is below snap_ratio × (length of an edge it shares with a crossing) is
-  /// moved onto the level set (φ set to 0) instead of inserting a point next to it.
+  /// Snapping: where the zero of φ on an edge (v, w) lies closer to v than snap_ratio × |vw|
+  /// (i.e. |φ(v)| / (|φ(v)| + |φ(w)|) < snap_ratio), v itself is put on the level set (φ(v) = 0,
+  /// the vertex does not move) instead of inserting a point next to it, which would leave a sliver.
+  /// A snap that would make the interface touch itself at a vertex is not done. 0 disables snapping.
   double snap_ratio = 0.05;
 };
 
 struct DiscretizeReport {
-  std::size_t crossed_edges = 0;
-  std::size_t inserted_vertices = 0;
-  std::size_t snapped_vertices = 0;
-  std::size_t split_faces = 0;
+  std::size_t crossed_edges = 0;      ///< edges where φ changes sign strictly (after snapping)
+  std::size_t inserted_vertices = 0;  ///< one per crossed edge
+  std::size_t snapped_vertices = 0;   ///< vertices whose φ was set to 0
+  std::size_t rejected_snaps = 0;     ///< snaps refused because they would pinch the interface
+  std::size_t split_faces = 0;        ///< input faces cut into 2 or 3 triangles
+  std::size_t flipped_diagonals = 0;  ///< quads (2-crossing pattern) where the other diagonal was better
+  std::size_t interface_edges = 0;    ///< edges tagged e:interface on return
+  std::size_t inside_faces = 0;       ///< faces labelled kInside on return
+  /// Vertices where the input φ is exactly 0 but the inside region would touch itself (a saddle
+  /// of φ at the vertex, or inside parts meeting at a boundary vertex): they are put on the
+  /// outside (φ set to a small positive value) and the cut passes next to them.
+  std::size_t separated_vertices = 0;
+  /// Vertices where the interface is still not a simple curve on return (interface-degree other
+  /// than 0 or 2, or more than 1 on the boundary). Always 0; kept as a self-check.
+  std::size_t pinched_vertices = 0;
 };
 
-/// Cut the zero level set of `phi` (one value per vertex) into `mesh` (garbage-collected on return).
+/// Cut the zero level set of `phi` (one value per vertex index) into `mesh`. Previous interface
+/// tags and region labels are replaced; ridge, required, corner and boundary tags are kept (the
+/// two halves of a split edge inherit them) and every face keeps its orientation. `mesh` is
+/// garbage-collected on return. Throws InputError when phi has the wrong size or is not finite.
 DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options = {});
 
 }  // namespace bodyfit

@@ -1,0 +1,265 @@
+// Marching triangles on a surface mesh: snap, split the crossed edges, pick the better diagonals,
+// label. Work is proportional to the crossed faces plus one pass over the elements.
+#include <bodyfit/error.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/levelset_mesher.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace bodyfit {
+
+namespace {
+
+bool opposite_signs(double a, double b) { return (a < 0 && b > 0) || (a > 0 && b < 0); }
+
+/// Position along (a, b) of the zero of the linear interpolant, as a fraction of |ab| from a.
+double zero_fraction(double a, double b) { return a / (a - b); }
+
+/// The cut as it will be once every crossed edge is split, seen from one vertex where φ = 0:
+/// its number of interface edges. A face (v, w, x) whose w and x have strict opposite signs adds
+/// the segment from v to the crossing on wx; an edge (v, w) with φ(w) = 0 is interface when exactly
+/// one of its two faces has a negative third vertex (faces with only zeros and positives are outside).
+int predicted_interface_degree(const SurfaceMesh& mesh, const ScalarField& value, VertexHandle v) {
+  int degree = 0;
+  for (auto h : mesh.voh_range(v)) {
+    auto w = mesh.to_vertex_handle(h);
+    double vw = value[w.idx()];
+    bool has_face = !mesh.is_boundary(h);
+    double x = has_face ? value[mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx()] : 0.0;
+    if (has_face && opposite_signs(vw, x)) ++degree;
+    auto o = mesh.opposite_halfedge_handle(h);
+    if (vw == 0 && has_face && !mesh.is_boundary(o)) {
+      double y = value[mesh.to_vertex_handle(mesh.next_halfedge_handle(o)).idx()];
+      if ((x < 0) != (y < 0)) ++degree;
+    }
+  }
+  return degree;
+}
+
+/// A simple interface curve passes through an interior vertex (degree 2) or misses it (0); on the
+/// boundary it may end there (1); more means the inside region touches itself at the vertex.
+bool acceptable_degree(const SurfaceMesh& mesh, VertexHandle v, int degree) {
+  return mesh.is_boundary(v) ? degree <= 1 : (degree == 0 || degree == 2);
+}
+
+/// Tags an edge carries that its two halves must keep after a split.
+struct EdgeTags {
+  int ref = 0;
+  SurfaceMesh::Flag ridge = 0, required = 0;
+};
+
+/// A face with two crossed edges: `lone` is the vertex alone on its side, (lone, b, c) in the face's
+/// orientation; the crossings p on (lone, b) and q on (c, lone) are found after the splits.
+struct QuadCut {
+  VertexHandle lone, b, c;
+  int edge_ab = -1, edge_ca = -1;
+};
+
+/// Snap the vertices whose crossing lies within snap_ratio of them (in index order, so the result
+/// does not depend on anything but the input), keeping every φ = 0 vertex a simple interface point.
+void snap(const SurfaceMesh& mesh, ScalarField& value, double snap_ratio, DiscretizeReport& report) {
+  if (snap_ratio <= 0) return;
+  std::vector<int> candidates;
+  for (auto e : mesh.edges()) {
+    auto h = mesh.halfedge_handle(e, 0);
+    int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+    if (!opposite_signs(value[a], value[b])) continue;
+    double t = zero_fraction(value[a], value[b]);
+    if (t < snap_ratio) candidates.push_back(a);
+    if (1 - t < snap_ratio) candidates.push_back(b);
+  }
+  std::sort(candidates.begin(), candidates.end());
+  candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+
+  std::vector<std::pair<VertexHandle, int>> zero_neighbours;
+  for (int index : candidates) {
+    VertexHandle v(index);
+    double old = value[index];
+    // A neighbour snapped earlier may have removed the close crossing.
+    bool still_close = false;
+    for (auto w : mesh.vv_range(v)) {
+      double vw = value[w.idx()];
+      if (opposite_signs(old, vw) && zero_fraction(old, vw) < snap_ratio) still_close = true;
+    }
+    if (!still_close) continue;
+    zero_neighbours.clear();
+    for (auto w : mesh.vv_range(v))
+      if (value[w.idx()] == 0) zero_neighbours.emplace_back(w, predicted_interface_degree(mesh, value, w));
+    value[index] = 0;
+    bool ok = acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v));
+    for (auto [w, before] : zero_neighbours) {
+      if (!ok) break;
+      int after = predicted_interface_degree(mesh, value, w);
+      ok = acceptable_degree(mesh, w, after) || after <= before;
+    }
+    if (ok) {
+      ++report.snapped_vertices;
+    } else {
+      value[index] = old;
+      ++report.rejected_snaps;
+    }
+  }
+}
+
+/// Where the input φ is exactly 0 at a vertex around which the cut would not be a simple curve
+/// (a saddle: inside parts meeting at the vertex), put the vertex on the outside: φ = δ > 0, the
+/// geometric mean of |φ| over its negative neighbours, so the new crossings sit at comparable
+/// fractions of their edges. This may spoil a zero neighbour in turn: repeat until none is left
+/// (each vertex moves at most once, since only vertices with φ = 0 can be spoiled).
+void separate_pinches(const SurfaceMesh& mesh, ScalarField& value, DiscretizeReport& report) {
+  std::vector<VertexHandle> work;
+  for (auto v : mesh.vertices())
+    if (value[v.idx()] == 0 && !acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v)))
+      work.push_back(v);
+  std::reverse(work.begin(), work.end());  // pop in index order
+  while (!work.empty()) {
+    auto v = work.back();
+    work.pop_back();
+    if (value[v.idx()] != 0 || acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v))) continue;
+    double smallest = 0, largest = 0;
+    for (auto w : mesh.vv_range(v)) {
+      double magnitude = -value[w.idx()];
+      if (magnitude <= 0) continue;
+      smallest = smallest == 0 ? magnitude : std::min(smallest, magnitude);
+      largest = std::max(largest, magnitude);
+    }
+    if (largest == 0) continue;  // cannot happen: an interface vertex has a negative neighbour
+    value[v.idx()] = std::sqrt(smallest * largest);
+    ++report.separated_vertices;
+    for (auto w : mesh.vv_range(v))
+      if (value[w.idx()] == 0 && !acceptable_degree(mesh, w, predicted_interface_degree(mesh, value, w)))
+        work.push_back(w);
+  }
+}
+
+void set_edge_tags(SurfaceMesh& mesh, EdgeHandle e, const EdgeTags& tags) {
+  mesh.edge_ref(e) = tags.ref;
+  mesh.ridge(e) = tags.ridge;
+  mesh.required(e) = tags.required;
+  mesh.interface(e) = 0;
+}
+
+/// Of the two triangulations of the quad (p, b, c, q), keep the one whose worse triangle is better.
+bool improve_diagonal(SurfaceMesh& mesh, VertexHandle p, VertexHandle b, VertexHandle c, VertexHandle q) {
+  const Vec3 &P = mesh.point(p), &B = mesh.point(b), &C = mesh.point(c), &Q = mesh.point(q);
+  double with_pc = std::min(triangle_quality(P, B, C), triangle_quality(P, C, Q));
+  double with_bq = std::min(triangle_quality(P, B, Q), triangle_quality(B, C, Q));
+  HalfedgeHandle current = mesh.find_halfedge(p, c);
+  bool want_bq = with_bq > with_pc;
+  if (!current.is_valid()) {
+    current = mesh.find_halfedge(b, q);
+    want_bq = !(with_pc > with_bq);
+    if (!current.is_valid() || want_bq) return false;
+  } else if (!want_bq) {
+    return false;
+  }
+  auto e = mesh.edge_handle(current);
+  if (!mesh.is_flip_ok(e)) return false;
+  mesh.flip(e);
+  return true;
+}
+
+}  // namespace
+
+DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options) {
+  DiscretizeReport report;
+  if (phi.size() != mesh.n_vertices())
+    throw InputError("discretize: the level set has " + std::to_string(phi.size()) + " values for " +
+                     std::to_string(mesh.n_vertices()) + " vertices");
+  ScalarField value = phi;
+  for (auto v : mesh.vertices())
+    if (!std::isfinite(value[v.idx()]))
+      throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
+
+  snap(mesh, value, options.snap_ratio, report);
+  separate_pinches(mesh, value, report);
+
+  // Crossed edges and the faces cut into a triangle and a quad, found on the unsplit mesh.
+  std::vector<EdgeHandle> crossed;
+  for (auto e : mesh.edges()) {
+    auto h = mesh.halfedge_handle(e, 0);
+    if (opposite_signs(value[mesh.from_vertex_handle(h).idx()], value[mesh.to_vertex_handle(h).idx()]))
+      crossed.push_back(e);
+  }
+  std::vector<QuadCut> quads;
+  for (auto e : crossed)
+    for (int side = 0; side < 2; ++side) {
+      // Each cut face is visited from each of its crossed edges: count it (and record its quad)
+      // from the halfedge leaving its lone vertex only, or from its single crossed edge.
+      auto h = mesh.halfedge_handle(e, side);
+      if (mesh.is_boundary(h)) continue;
+      auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);
+      auto hc = mesh.next_halfedge_handle(h);
+      auto c = mesh.to_vertex_handle(hc);
+      double va = value[a.idx()], vc = value[c.idx()];
+      if (vc == 0) {
+        ++report.split_faces;
+      } else if (opposite_signs(va, vc)) {  // a is the lone vertex: (a, b) and (c, a) are crossed
+        ++report.split_faces;
+        quads.push_back({a, b, c, e.idx(), mesh.edge_handle(mesh.next_halfedge_handle(hc)).idx()});
+      }
+    }
+  report.crossed_edges = crossed.size();
+
+  // Split every crossed edge at the zero of the linear interpolant.
+  std::vector<VertexHandle> crossing(mesh.n_edges());
+  value.reserve(value.size() + crossed.size());
+  for (auto e : crossed) {
+    auto h = mesh.halfedge_handle(e, 0);
+    auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);
+    double t = zero_fraction(value[a.idx()], value[b.idx()]);
+    Vec3 point = mesh.point(a) + t * (mesh.point(b) - mesh.point(a));
+    EdgeTags tags{mesh.edge_ref(e) == kInterfaceRef ? 0 : mesh.edge_ref(e), mesh.ridge(e), mesh.required(e)};
+    auto p = mesh.add_vertex(point);
+    mesh.vertex_ref(p) = 0;
+    mesh.corner(p) = 0;
+    mesh.required(p) = 0;
+    value.push_back(0);
+    crossing[e.idx()] = p;
+    mesh.split(e, p);
+    // OpenMesh leaves the properties of the new edges undefined: the halves of e keep its tags,
+    // the edges to the opposite vertices start untagged.
+    for (auto ph : mesh.voh_range(p)) {
+      auto w = mesh.to_vertex_handle(ph);
+      set_edge_tags(mesh, mesh.edge_handle(ph), w == a || w == b ? tags : EdgeTags{});
+    }
+  }
+  report.inserted_vertices = crossed.size();
+
+  for (const auto& quad : quads)
+    if (improve_diagonal(mesh, crossing[quad.edge_ab], quad.b, quad.c, crossing[quad.edge_ca]))
+      ++report.flipped_diagonals;
+
+  // Every face now lies on one side: inside when a vertex is negative.
+  for (auto f : mesh.faces()) {
+    bool inside = false;
+    for (auto v : mesh.fv_range(f)) inside |= value[v.idx()] < 0;
+    mesh.region(f) = inside ? kInside : kOutside;
+    report.inside_faces += inside;
+  }
+  for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
+  update_interface_from_regions(mesh);
+
+  std::vector<int> degree;
+  for (auto e : mesh.edges()) {
+    if (!mesh.interface(e)) continue;
+    ++report.interface_edges;
+    if (degree.empty()) degree.assign(mesh.n_vertices(), 0);
+    for (int side = 0; side < 2; ++side) ++degree[mesh.to_vertex_handle(mesh.halfedge_handle(e, side)).idx()];
+  }
+  if (!degree.empty())
+    for (auto v : mesh.vertices())
+      if (!acceptable_degree(mesh, v, degree[v.idx()])) ++report.pinched_vertices;
+
+  bool has_deleted = false;
+  for (std::size_t i = 0; i < mesh.n_faces() && !has_deleted; ++i) has_deleted = mesh.status(FaceHandle(int(i))).deleted();
+  for (std::size_t i = 0; i < mesh.n_edges() && !has_deleted; ++i) has_deleted = mesh.status(EdgeHandle(int(i))).deleted();
+  for (std::size_t i = 0; i < mesh.n_vertices() && !has_deleted; ++i)
+    has_deleted = mesh.status(VertexHandle(int(i))).deleted();
+  if (has_deleted) mesh.garbage_collection();
+  return report;
+}
+
+}  // namespace bodyfit
