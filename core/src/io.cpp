@@ -1,79 +1,256 @@
-// TEMPORARY minimal implementation (ASCII Medit only, no validation); the io helper replaces it.
+// Mesh I/O: format dispatch and the validated builder shared by every reader.
+#include "io_internal.hpp"
+
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/io.hpp>
 
-#include <fstream>
-#include <sstream>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
 
 namespace bodyfit {
+namespace io_detail {
 
-SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions&) {
-  std::ifstream in(file);
-  if (!in) throw file_error(file, "cannot open");
+InputError Locator::error(const std::filesystem::path& file, std::size_t i, const std::string& what) const {
+  if (none_) return file_error(file, what);
+  if (binary_) return file_error(file, fmt::format("byte {}: {}", start_ + i * stride_, what));
+  if (i < lines_.size()) return file_error(file, static_cast<long>(lines_[i]), what);
+  return file_error(file, what);
+}
+
+std::string extension_of(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+std::string read_file_bytes(const std::filesystem::path& file) {
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(file.c_str(), "rb"), &std::fclose);
+  if (!in) throw file_error(file, fmt::format("cannot open for reading ({})", std::strerror(errno)));
+  if (std::filesystem::is_directory(file)) throw file_error(file, "cannot read: it is a directory");
+  std::string bytes;
+  char chunk[1 << 16];
+  std::size_t got;
+  std::error_code ec;
+  auto size = std::filesystem::file_size(file, ec);
+  if (!ec) bytes.reserve(size);
+  while ((got = std::fread(chunk, 1, sizeof chunk, in.get())) > 0) bytes.append(chunk, got);
+  if (std::ferror(in.get())) throw file_error(file, "read error");
+  return bytes;
+}
+
+std::vector<std::int64_t> vertex_numbering(const SurfaceMesh& mesh) {
+  std::vector<std::int64_t> index(mesh.n_vertices(), -1);
+  std::int64_t next = 0;
+  for (auto v : mesh.vertices()) index[v.idx()] = next++;
+  return index;
+}
+
+namespace {
+
+/// Diagnose why OpenMesh refused triangle (a, b, c): an edge already used twice, an edge used
+/// once with the same orientation (a duplicate triangle or an inconsistent orientation), or else
+/// a vertex whose fan cannot take one more triangle.
+std::string diagnose_refused_triangle(const SurfaceMesh& mesh, const std::array<VertexHandle, 3>& v) {
+  for (int k = 0; k < 3; ++k) {
+    auto a = v[k], b = v[(k + 1) % 3];
+    auto h = mesh.find_halfedge(a, b);
+    if (!h.is_valid() || mesh.is_boundary(h)) continue;
+    auto opposite = mesh.opposite_halfedge_handle(h);
+    if (!mesh.is_boundary(opposite))
+      return fmt::format("non-manifold edge {}-{}: it already borders two triangles", a.idx() + 1, b.idx() + 1);
+    auto f = mesh.face_handle(h);
+    std::array<int, 3> mine{v[0].idx(), v[1].idx(), v[2].idx()}, theirs{};
+    int i = 0;
+    for (auto w : mesh.fv_range(f)) theirs[i++] = w.idx();
+    std::sort(mine.begin(), mine.end());
+    std::sort(theirs.begin(), theirs.end());
+    if (mine == theirs) return fmt::format("duplicate triangle (same vertices as triangle {})", f.idx() + 1);
+    return fmt::format("inconsistent orientation: edge {}-{} is traversed in the same direction by triangle {}",
+                       a.idx() + 1, b.idx() + 1, f.idx() + 1);
+  }
+  return "non-manifold vertex: a vertex of this triangle already has a closed fan of triangles or would join two "
+         "fans";
+}
+
+/// The halfedge a→b or b→a, invalid when a-b is not a mesh edge.
+EdgeHandle find_edge(const SurfaceMesh& mesh, VertexHandle a, VertexHandle b) {
+  auto h = mesh.find_halfedge(a, b);
+  return h.is_valid() ? mesh.edge_handle(h) : EdgeHandle();
+}
+
+/// OpenMesh prints to omerr when add_face fails; the builder reports the failure itself.
+class SilenceOpenMeshErrors {
+ public:
+  SilenceOpenMeshErrors() : was_enabled_(omerr().is_enabled()) { omerr().disable(); }
+  ~SilenceOpenMeshErrors() {
+    if (was_enabled_) omerr().enable();
+  }
+  SilenceOpenMeshErrors(const SilenceOpenMeshErrors&) = delete;
+  SilenceOpenMeshErrors& operator=(const SilenceOpenMeshErrors&) = delete;
+
+ private:
+  bool was_enabled_;
+};
+
+}  // namespace
+
+SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const ReadOptions& options) {
+  const std::int64_t nv = static_cast<std::int64_t>(r.points.size());
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    const auto& p = r.points[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw r.vertex_at.error(file, i, fmt::format("vertex {} has a NaN or infinite coordinate", i + 1));
+  }
+
+  // Indices, degenerate triangles and the mesh scale.
+  double length_sum = 0;
+  for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+    const auto& tri = r.triangles[t];
+    for (auto i : tri)
+      if (i < 0 || i >= nv)
+        throw r.triangle_at.error(file, t,
+                                  fmt::format("triangle {} refers to vertex {}, expected an index in 1..{}", t + 1,
+                                              i + 1, nv));
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      throw r.triangle_at.error(file, t, fmt::format("triangle {} uses the same vertex twice", t + 1));
+    for (int k = 0; k < 3; ++k) length_sum += (r.points[tri[(k + 1) % 3]] - r.points[tri[k]]).norm();
+  }
+  if (!r.triangles.empty()) {
+    const double mean_length = length_sum / (3.0 * double(r.triangles.size()));
+    const double min_area = options.min_relative_area * mean_length * mean_length;
+    for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+      const auto& tri = r.triangles[t];
+      const double area =
+          0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
+      if (!(area > min_area))
+        throw r.triangle_at.error(
+            file, t,
+            fmt::format("triangle {} has zero area ({:.3g}, below {:.3g} x mean edge length^2)", t + 1, area,
+                        options.min_relative_area));
+    }
+  }
+
   SurfaceMesh mesh;
-  std::string word;
-  std::vector<VertexHandle> vs;
-  while (in >> word) {
-    if (word == "Vertices") {
-      std::size_t n;
-      in >> n;
-      for (std::size_t i = 0; i < n; ++i) {
-        double x, y, z;
-        int ref;
-        in >> x >> y >> z >> ref;
-        vs.push_back(mesh.add_vertex(Vec3(x, y, z)));
-      }
-    } else if (word == "Triangles") {
-      std::size_t n;
-      in >> n;
-      for (std::size_t i = 0; i < n; ++i) {
-        int a, b, c, ref;
-        in >> a >> b >> c >> ref;
-        auto f = mesh.add_face(vs[a - 1], vs[b - 1], vs[c - 1]);
-        mesh.region(f) = ref;
+  mesh.reserve(r.points.size(), r.points.size() + r.triangles.size(), r.triangles.size());
+  for (std::size_t i = 0; i < r.points.size(); ++i) {
+    auto v = mesh.add_vertex(r.points[i]);
+    mesh.vertex_ref(v) = i < r.vertex_refs.size() ? r.vertex_refs[i] : 0;
+  }
+  {
+    SilenceOpenMeshErrors silence;
+    for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+      const auto& tri = r.triangles[t];
+      std::array<VertexHandle, 3> v{VertexHandle(int(tri[0])), VertexHandle(int(tri[1])), VertexHandle(int(tri[2]))};
+      // A triangle with the opposite orientation of an existing one would be accepted: catch it first.
+      auto h = mesh.find_halfedge(v[1], v[0]);
+      if (h.is_valid() && !mesh.is_boundary(h) && mesh.to_vertex_handle(mesh.next_halfedge_handle(h)) == v[2])
+        throw r.triangle_at.error(
+            file, t,
+            fmt::format("triangle {} is a duplicate (same vertices as triangle {}, opposite orientation)", t + 1,
+                        mesh.face_handle(h).idx() + 1));
+      auto f = mesh.add_face(v[0], v[1], v[2]);
+      if (!f.is_valid())
+        throw r.triangle_at.error(file, t, fmt::format("triangle {}: {}", t + 1, diagnose_refused_triangle(mesh, v)));
+      mesh.region(f) = t < r.triangle_refs.size() ? r.triangle_refs[t] : 0;
+    }
+  }
+  // A vertex where two fans touch has two outgoing boundary halfedges (OpenMesh accepts it).
+  {
+    std::vector<char> boundary_out(mesh.n_vertices(), 0);
+    for (auto h : mesh.halfedges()) {
+      if (!mesh.is_boundary(h)) continue;
+      auto v = mesh.from_vertex_handle(h);
+      if (boundary_out[v.idx()]++)
+        throw r.vertex_at.error(file, std::size_t(v.idx()),
+                                fmt::format("vertex {} is non-manifold: two separate fans of triangles meet there",
+                                            v.idx() + 1));
+    }
+  }
+
+  // Edges and their tags.
+  std::vector<EdgeHandle> listed(r.edges.size());
+  for (std::size_t i = 0; i < r.edges.size(); ++i) {
+    auto [a, b] = r.edges[i];
+    if (a < 0 || a >= nv || b < 0 || b >= nv)
+      throw r.edge_at.error(file, i,
+                            fmt::format("edge {} refers to vertex {}, expected an index in 1..{}", i + 1,
+                                        (a < 0 || a >= nv) ? a + 1 : b + 1, nv));
+    auto e = find_edge(mesh, VertexHandle(int(a)), VertexHandle(int(b)));
+    if (!e.is_valid())
+      throw r.edge_at.error(file, i, fmt::format("edge {} ({}-{}) is not a side of any triangle", i + 1, a + 1, b + 1));
+    listed[i] = e;
+    mesh.edge_ref(e) = i < r.edge_refs.size() ? r.edge_refs[i] : 0;
+    if (mesh.edge_ref(e) == kInterfaceRef) mesh.interface(e) = 1;
+  }
+  auto edge_list_item = [&](const std::vector<std::int64_t>& items, const Locator& at, const char* section,
+                            std::size_t k) {
+    auto i = items[k];
+    if (i < 0 || i >= std::int64_t(listed.size()))
+      throw at.error(file, k,
+                     fmt::format("{} entry {} refers to edge {}, expected an index into Edges 1..{}", section, k + 1,
+                                 i + 1, listed.size()));
+    return listed[std::size_t(i)];
+  };
+  for (std::size_t k = 0; k < r.ridges.size(); ++k) mesh.ridge(edge_list_item(r.ridges, r.ridge_at, "Ridges", k)) = 1;
+  for (std::size_t k = 0; k < r.required_edges.size(); ++k)
+    mesh.required(edge_list_item(r.required_edges, r.required_edge_at, "RequiredEdges", k)) = 1;
+  auto vertex_list_item = [&](const std::vector<std::int64_t>& items, const Locator& at, const char* section,
+                              std::size_t k) {
+    auto i = items[k];
+    if (i < 0 || i >= nv)
+      throw at.error(file, k,
+                     fmt::format("{} entry {} refers to vertex {}, expected an index in 1..{}", section, k + 1, i + 1,
+                                 nv));
+    return VertexHandle(int(i));
+  };
+  for (std::size_t k = 0; k < r.corners.size(); ++k)
+    mesh.corner(vertex_list_item(r.corners, r.corner_at, "Corners", k)) = 1;
+  for (std::size_t k = 0; k < r.required_vertices.size(); ++k)
+    mesh.required(vertex_list_item(r.required_vertices, r.required_vertex_at, "RequiredVertices", k)) = 1;
+
+  // The interface: edges listed with ref 10, and edges between an inside and a non-inside face.
+  if (mesh.has_regions()) {
+    for (auto e : mesh.edges()) {
+      if (mesh.is_boundary(e)) continue;
+      auto f0 = mesh.face_handle(mesh.halfedge_handle(e, 0));
+      auto f1 = mesh.face_handle(mesh.halfedge_handle(e, 1));
+      if (mesh.inside(f0) != mesh.inside(f1)) {
+        mesh.interface(e) = 1;
+        if (mesh.edge_ref(e) == 0) mesh.edge_ref(e) = kInterfaceRef;
       }
     }
   }
-  update_interface_from_regions(mesh);
   return mesh;
 }
 
+}  // namespace io_detail
+
+SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options) {
+  using namespace io_detail;
+  const std::string ext = extension_of(file);
+  if (ext == ".mesh" || ext == ".meshb") return read_medit(file, options);
+  if (ext == ".obj" || ext == ".off" || ext == ".ply" || ext == ".stl") return read_openmesh_format(file, options);
+  throw file_error(file, fmt::format("unknown mesh extension '{}' (expected .mesh, .meshb, .obj, .off, .ply or .stl)",
+                                     ext));
+}
+
 void write_mesh(const SurfaceMesh& mesh, const std::filesystem::path& file) {
-  write_atomically(file, [&](std::ostream& out) {
-    out.precision(17);
-    out << "MeshVersionFormatted 2\nDimension 3\nVertices\n" << mesh.n_vertices() << "\n";
-    for (auto v : mesh.vertices()) out << mesh.point(v)[0] << ' ' << mesh.point(v)[1] << ' ' << mesh.point(v)[2] << " 0\n";
-    out << "Triangles\n" << mesh.n_faces() << "\n";
-    for (auto f : mesh.faces()) {
-      for (auto v : mesh.fv_range(f)) out << v.idx() + 1 << ' ';
-      out << mesh.region(f) << "\n";
-    }
-    out << "End\n";
-  });
-}
-
-void write_scalar_sol(const std::filesystem::path& file, const ScalarField& values) {
-  write_atomically(file, [&](std::ostream& out) {
-    out.precision(17);
-    out << "MeshVersionFormatted 2\nDimension 3\nSolAtVertices\n" << values.size() << "\n1 1\n";
-    for (double v : values) out << v << "\n";
-    out << "End\n";
-  });
-}
-
-ScalarField read_scalar_sol(const std::filesystem::path& file, std::size_t expected) {
-  std::ifstream in(file);
-  if (!in) throw file_error(file, "cannot open");
-  std::string word;
-  while (in >> word && word != "SolAtVertices") {}
-  std::size_t n;
-  int a, b;
-  in >> n >> a >> b;
-  if (expected && n != expected) throw file_error(file, "size mismatch");
-  ScalarField values(n);
-  for (auto& v : values) in >> v;
-  return values;
+  using namespace io_detail;
+  const std::string ext = extension_of(file);
+  if (ext == ".mesh" || ext == ".meshb") return write_medit(mesh, file, ext == ".meshb");
+  if (ext == ".obj" || ext == ".off" || ext == ".ply" || ext == ".stl") return write_openmesh_format(mesh, file);
+  if (ext == ".vtu") return write_vtu(mesh, file);
+  throw file_error(file, fmt::format("unknown mesh extension '{}' (expected .mesh, .meshb, .obj, .off, .ply, .stl "
+                                     "or .vtu)",
+                                     ext));
 }
 
 }  // namespace bodyfit

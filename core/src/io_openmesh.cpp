@@ -1,0 +1,110 @@
+// OBJ, OFF, PLY and STL through OpenMesh's readers and writers. The reader's result is turned back
+// into plain records and rebuilt by the validated builder, so these formats get the same checks
+// as Medit files. OpenMesh's importer repairs non-manifold input silently (it duplicates the
+// vertices of a face it cannot add and marks it "fixed non-manifold") and reports other problems
+// only on omerr: both are turned into an InputError.
+#include "io_internal.hpp"
+
+#include <bodyfit/atomic_file.hpp>
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <fmt/format.h>
+
+#include <iostream>
+#include <sstream>
+
+namespace bodyfit::io_detail {
+namespace {
+
+/// Collect what OpenMesh prints on omerr while in scope (instead of letting it reach stderr).
+class CaptureOpenMeshErrors {
+ public:
+  CaptureOpenMeshErrors() : log_was_enabled_(omlog().is_enabled()) {
+    was_on_cerr_ = omerr().disconnect(std::cerr);
+    omerr().connect(captured_);
+    omlog().disable();  // OpenMesh's writers log "[OBJWriter] : write file" on every call
+  }
+  ~CaptureOpenMeshErrors() {
+    omerr().flush();
+    omerr().disconnect(captured_);
+    if (was_on_cerr_) omerr().connect(std::cerr);
+    if (log_was_enabled_) omlog().enable();
+  }
+  CaptureOpenMeshErrors(const CaptureOpenMeshErrors&) = delete;
+  CaptureOpenMeshErrors& operator=(const CaptureOpenMeshErrors&) = delete;
+  /// The first line printed so far (empty when nothing was).
+  std::string first_line() {
+    omerr().flush();
+    std::string text = captured_.str();
+    auto end = text.find('\n');
+    text = text.substr(0, end);
+    while (!text.empty() && (text.back() == '\r' || text.back() == ' ')) text.pop_back();
+    return text;
+  }
+
+ private:
+  std::ostringstream captured_;
+  bool was_on_cerr_ = false;
+  bool log_was_enabled_ = true;
+};
+
+}  // namespace
+
+SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options) {
+  read_file_bytes(file);  // a clear error for a missing or unreadable file
+  SurfaceMesh raw;
+  OpenMesh::IO::Options io_options;
+  std::string complaint;
+  bool ok = false;
+  {
+    CaptureOpenMeshErrors capture;
+    ok = OpenMesh::IO::read_mesh(raw, file.string(), io_options);
+    complaint = capture.first_line();
+  }
+  if (!ok)
+    throw file_error(file, complaint.empty() ? std::string("OpenMesh could not read this file (malformed?)")
+                                             : "OpenMesh could not read this file: " + complaint);
+  for (auto f : raw.faces())
+    if (raw.status(f).fixed_nonmanifold())
+      throw file_error(file, fmt::format("face {} makes a non-manifold edge or vertex (OpenMesh had to duplicate its "
+                                         "vertices to read it)",
+                                         f.idx() + 1));
+  if (!complaint.empty()) throw file_error(file, "OpenMesh reported a problem: " + complaint);
+
+  MeshRecords records;
+  records.vertex_at = records.triangle_at = Locator::none();
+  records.points.reserve(raw.n_vertices());
+  for (auto v : raw.vertices()) records.points.push_back(raw.point(v));
+  records.triangles.reserve(raw.n_faces());
+  for (auto f : raw.faces()) {
+    std::array<std::int64_t, 3> tri{};
+    int k = 0;
+    for (auto v : raw.fv_range(f)) tri[k++] = v.idx();
+    records.triangles.push_back(tri);
+  }
+  return build_mesh(std::move(records), file, options);
+}
+
+void write_openmesh_format(const SurfaceMesh& mesh, const std::filesystem::path& file) {
+  const std::string ext = extension_of(file);
+  const SurfaceMesh* source = &mesh;
+  SurfaceMesh compacted;
+  if (mesh.n_vertices() != std::size_t(std::distance(mesh.vertices().begin(), mesh.vertices().end())) ||
+      mesh.n_faces() != std::size_t(std::distance(mesh.faces().begin(), mesh.faces().end()))) {
+    compacted = mesh;
+    compacted.garbage_collection();
+    source = &compacted;
+  }
+  write_atomically(file, [&](std::ostream& out) {
+    std::string complaint;
+    bool ok = false;
+    {
+      CaptureOpenMeshErrors capture;
+      ok = OpenMesh::IO::write_mesh(*source, out, ext, OpenMesh::IO::Options::Default, 17);
+      complaint = capture.first_line();
+    }
+    if (!ok) throw file_error(file, "OpenMesh could not write this format" + (complaint.empty() ? "" : ": " + complaint));
+  });
+}
+
+}  // namespace bodyfit::io_detail

@@ -1,0 +1,739 @@
+// File formats: round trips (bit-exact), MMG-style fixtures, hand-encoded binary files and every
+// kind of bad input (each error must name the file and the line or byte offset).
+#include <bodyfit/error.hpp>
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+
+using namespace bodyfit;
+using bodyfit::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// The message of the InputError thrown by f ("" when nothing is thrown).
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+/// Files left in a directory (the writers' temporaries included).
+std::size_t files_in(const fs::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n;
+  return n;
+}
+
+/// A sphere with every property set to something non-trivial and deterministic.
+SurfaceMesh tagged_sphere(std::size_t faces) {
+  SurfaceMesh mesh = make_sphere({.faces = faces});
+  std::mt19937 rng(7);
+  for (auto v : mesh.vertices()) {
+    const auto& p = mesh.point(v);
+    mesh.phi(v) = p[2] - 0.1;
+    mesh.vertex_ref(v) = int(rng() % 3);
+    mesh.corner(v) = rng() % 7 == 0;
+    mesh.required(v) = rng() % 5 == 0;
+  }
+  label_regions_from_phi(mesh);
+  for (auto e : mesh.edges()) {
+    if (mesh.interface(e)) continue;
+    mesh.edge_ref(e) = rng() % 4 == 0 ? int(1 + rng() % 5) : 0;
+    mesh.ridge(e) = rng() % 6 == 0;
+    mesh.required(e) = rng() % 8 == 0;
+  }
+  return mesh;
+}
+
+/// Same vertices (bit-exact), same faces in the same order, same refs and tags.
+/// With a tolerance > 0, coordinates may differ by that much (formats read in single precision).
+void check_identical(const SurfaceMesh& a, const SurfaceMesh& b, bool with_tags, double tolerance = 0) {
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  REQUIRE(a.n_faces() == b.n_faces());
+  for (auto v : a.vertices()) {
+    auto w = VertexHandle(v.idx());
+    for (int k = 0; k < 3; ++k) {
+      if (tolerance > 0)
+        REQUIRE(std::abs(a.point(v)[k] - b.point(w)[k]) <= tolerance);
+      else
+        REQUIRE(std::memcmp(&a.point(v)[k], &b.point(w)[k], sizeof(double)) == 0);
+    }
+    if (with_tags) {
+      CHECK(a.vertex_ref(v) == b.vertex_ref(w));
+      CHECK(a.corner(v) == b.corner(w));
+      CHECK(a.required(v) == b.required(w));
+    }
+  }
+  for (auto f : a.faces()) {
+    auto g = FaceHandle(f.idx());
+    std::vector<int> va, vb;
+    for (auto v : a.fv_range(f)) va.push_back(v.idx());
+    for (auto v : b.fv_range(g)) vb.push_back(v.idx());
+    REQUIRE(va == vb);
+    if (with_tags) CHECK(a.region(f) == b.region(g));
+  }
+  if (!with_tags) return;
+  for (auto e : a.edges()) {
+    auto h = a.halfedge_handle(e, 0);
+    auto hb = b.find_halfedge(VertexHandle(a.from_vertex_handle(h).idx()), VertexHandle(a.to_vertex_handle(h).idx()));
+    REQUIRE(hb.is_valid());
+    auto eb = b.edge_handle(hb);
+    CHECK(a.interface(e) == b.interface(eb));
+    CHECK(a.ridge(e) == b.ridge(eb));
+    CHECK(a.required(e) == b.required(eb));
+    CHECK((a.interface(e) ? kInterfaceRef : a.edge_ref(e)) == b.edge_ref(eb));
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// A GMF binary encoder written independently of the library, one field at a time.
+
+struct GmfEncoder {
+  int version;
+  bool big_endian = false;
+  std::string bytes;
+
+  template <class T>
+  void put(T value) {
+    char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    if (big_endian) std::reverse(raw, raw + sizeof(T));
+    bytes.append(raw, sizeof(T));
+  }
+  void integer(std::int64_t i) {
+    if (version >= 4)
+      put<std::int64_t>(i);
+    else
+      put<std::int32_t>(std::int32_t(i));
+  }
+  void real(double x) {
+    if (version == 1)
+      put<float>(float(x));
+    else
+      put<double>(x);
+  }
+  /// Keyword code and a placeholder position, patched by the next keyword.
+  void keyword(int code) {
+    patch_previous();
+    put<std::int32_t>(code);
+    position_at = bytes.size();
+    if (version >= 3)
+      put<std::int64_t>(0);
+    else
+      put<std::int32_t>(0);
+  }
+  void patch_previous() {
+    if (position_at == 0) return;
+    GmfEncoder patch{version, big_endian, {}};
+    if (version >= 3)
+      patch.put<std::int64_t>(std::int64_t(bytes.size()));
+    else
+      patch.put<std::int32_t>(std::int32_t(bytes.size()));
+    bytes.replace(position_at, patch.bytes.size(), patch.bytes);
+  }
+  void end() {
+    keyword(54);
+    position_at = 0;  // End's own next position stays 0
+  }
+  std::size_t position_at = 0;
+};
+
+/// The octahedron of the fixture, as a GMF binary of the given version (with a Normals
+/// section to skip).
+std::string octahedron_meshb(int version, bool big_endian) {
+  GmfEncoder g{version, big_endian, {}};
+  g.put<std::int32_t>(1);
+  g.put<std::int32_t>(version);
+  g.keyword(3);
+  g.put<std::int32_t>(3);
+  const double points[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  g.keyword(4);
+  g.integer(6);
+  for (int i = 0; i < 6; ++i) {
+    for (double x : points[i]) g.real(x);
+    g.integer(i == 1 ? 4 : 0);
+  }
+  g.keyword(60);  // Normals: skipped
+  g.integer(1);
+  for (int k = 0; k < 3; ++k) g.real(1.0);
+  const int triangles[8][4] = {{1, 3, 5, 3}, {3, 2, 5, 3}, {2, 4, 5, 3}, {4, 1, 5, 3},
+                               {3, 1, 6, 2}, {2, 3, 6, 2}, {4, 2, 6, 2}, {1, 4, 6, 2}};
+  g.keyword(6);
+  g.integer(8);
+  for (const auto& t : triangles)
+    for (int i : t) g.integer(i);
+  g.keyword(5);
+  g.integer(2);
+  for (int i : {1, 3, 10, 1, 5, 7}) g.integer(i);
+  g.keyword(14);  // Ridges
+  g.integer(1);
+  g.integer(2);
+  g.keyword(13);  // Corners
+  g.integer(1);
+  g.integer(5);
+  g.end();
+  return g.bytes;
+}
+
+EdgeHandle edge_between(const SurfaceMesh& mesh, int a, int b) {
+  auto h = mesh.find_halfedge(VertexHandle(a - 1), VertexHandle(b - 1));
+  REQUIRE(h.is_valid());
+  return mesh.edge_handle(h);
+}
+
+void check_fixture_octahedron(const SurfaceMesh& mesh, bool full_tags) {
+  REQUIRE(mesh.n_vertices() == 6);
+  REQUIRE(mesh.n_faces() == 8);
+  for (int f = 0; f < 8; ++f) CHECK(mesh.region(FaceHandle(f)) == (f < 4 ? kInside : kOutside));
+  CHECK(mesh.vertex_ref(VertexHandle(1)) == 4);
+  int interfaces = 0;
+  for (auto e : mesh.edges()) interfaces += mesh.interface(e);
+  CHECK(interfaces == 4);
+  for (auto [a, b] : {std::pair{1, 3}, {3, 2}, {2, 4}, {4, 1}}) {
+    CHECK(mesh.interface(edge_between(mesh, a, b)));
+    CHECK(mesh.edge_ref(edge_between(mesh, a, b)) == kInterfaceRef);
+  }
+  if (!full_tags) return;
+  CHECK(mesh.edge_ref(edge_between(mesh, 1, 5)) == 7);
+  CHECK(mesh.ridge(edge_between(mesh, 1, 5)));
+  CHECK(mesh.corner(VertexHandle(4)));
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+
+TEST_CASE("MMG-style .mesh fixture: every section read and mapped onto the mesh properties") {
+  auto mesh = read_mesh(test::source_path("meshes/fixtures/mmgs_octahedron.mesh"));
+  check_fixture_octahedron(mesh, true);
+  CHECK(mesh.required(edge_between(mesh, 3, 2)));
+  int ridges = 0, required_edges = 0, corners = 0, required_vertices = 0;
+  for (auto e : mesh.edges()) ridges += mesh.ridge(e), required_edges += mesh.required(e);
+  for (auto v : mesh.vertices()) corners += mesh.corner(v), required_vertices += mesh.required(v);
+  CHECK(ridges == 1);
+  CHECK(required_edges == 1);
+  CHECK(corners == 2);
+  CHECK(mesh.corner(VertexHandle(5)));
+  CHECK(required_vertices == 1);
+  CHECK(mesh.required(VertexHandle(0)));
+  CHECK(mesh.point(VertexHandle(1)) == Vec3(-1, 0, 0));
+}
+
+TEST_CASE("compact .mesh (keywords and numbers on shared lines, comments): interface derived from the regions") {
+  auto mesh = read_mesh(test::source_path("meshes/fixtures/mmgs_octahedron_compact.mesh"));
+  check_fixture_octahedron(mesh, false);
+}
+
+TEST_CASE("hand-encoded .meshb of every GMF version and both byte orders") {
+  TempDir dir("io-meshb");
+  for (int version = 1; version <= 4; ++version)
+    for (bool big_endian : {false, true}) {
+      CAPTURE(version);
+      CAPTURE(big_endian);
+      auto file = dir / "octa.meshb";
+      write_text(file, octahedron_meshb(version, big_endian));
+      auto mesh = read_mesh(file);
+      check_fixture_octahedron(mesh, true);
+      CHECK(mesh.ridge(edge_between(mesh, 1, 5)));
+    }
+}
+
+TEST_CASE("round trip .mesh and .meshb: bit-exact points, same faces, refs and tags") {
+  TempDir dir("io-roundtrip");
+  auto mesh = tagged_sphere(3000);
+  // Coordinates that need all 17 digits.
+  mesh.point(VertexHandle(0)) *= (1.0 + std::numeric_limits<double>::epsilon());
+  mesh.point(VertexHandle(1))[0] = 0.1 + 0.2;
+  for (const char* name : {"s.mesh", "s.meshb"}) {
+    CAPTURE(name);
+    write_mesh(mesh, dir / name);
+    auto back = read_mesh(dir / name);
+    check_identical(mesh, back, true);
+    // Writing what was read gives the same bytes.
+    write_mesh(back, dir / (std::string("again-") + name));
+    CHECK(read_text(dir / name) == read_text(dir / (std::string("again-") + name)));
+  }
+  CHECK(files_in(dir.path()) == 4);
+}
+
+TEST_CASE("Edges section: interface edges with ref 10, ridges, required, refs and boundary edges") {
+  TempDir dir("io-edges");
+  // An open square of two triangles: four boundary edges, one inner interface edge.
+  SurfaceMesh mesh;
+  VertexHandle v[4];
+  v[0] = mesh.add_vertex(Vec3(0, 0, 0));
+  v[1] = mesh.add_vertex(Vec3(1, 0, 0));
+  v[2] = mesh.add_vertex(Vec3(1, 1, 0));
+  v[3] = mesh.add_vertex(Vec3(0, 1, 0));
+  auto f0 = mesh.add_face(v[0], v[1], v[2]);
+  auto f1 = mesh.add_face(v[0], v[2], v[3]);
+  mesh.region(f0) = kInside;
+  mesh.region(f1) = kOutside;
+  update_interface_from_regions(mesh);
+  write_mesh(mesh, dir / "square.mesh");
+  const std::string text = read_text(dir / "square.mesh");
+  CHECK(contains(text, "\nEdges\n5\n"));
+  CHECK((contains(text, "\n1 3 10\n") || contains(text, "\n3 1 10\n")));
+  auto back = read_mesh(dir / "square.mesh");
+  check_identical(mesh, back, true);
+}
+
+TEST_CASE("round trip .sol and .solb with several scalar and vector fields") {
+  TempDir dir("io-sol");
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<SolField> fields(3);
+  fields[0] = {"", 1, {}};
+  fields[1] = {"", 3, {}};
+  fields[2] = {"", 1, {}};
+  for (int i = 0; i < 50; ++i)
+    for (auto& f : fields)
+      for (int k = 0; k < f.dimension; ++k) f.values.push_back(u(rng) * std::pow(10.0, int(rng() % 40) - 20));
+  fields[0].values[0] = 5e-324;  // subnormal
+  for (const char* name : {"f.sol", "f.solb"}) {
+    CAPTURE(name);
+    write_sol(dir / name, fields);
+    auto back = read_sol_all(dir / name, 50);
+    REQUIRE(back.size() == 3);
+    for (int i = 0; i < 3; ++i) {
+      CHECK(back[i].dimension == fields[i].dimension);
+      REQUIRE(back[i].values.size() == fields[i].values.size());
+      CHECK(std::memcmp(back[i].values.data(), fields[i].values.data(), 8 * fields[i].values.size()) == 0);
+    }
+  }
+  ScalarField phi{0.5, -0.25, 1e-17};
+  write_scalar_sol(dir / "phi.sol", phi);
+  CHECK(read_scalar_sol(dir / "phi.sol", 3) == phi);
+  VectorField velocity{Vec3(1, 2, 3), Vec3(-0.1, 0.2, 1e300)};
+  write_vector_sol(dir / "v.solb", velocity);
+  CHECK(read_vector_sol(dir / "v.solb", 2) == velocity);
+}
+
+TEST_CASE("mshdist-style .sol fixture with a scalar and a vector field") {
+  auto fields = read_sol_all(test::source_path("meshes/fixtures/mshdist_octahedron.sol"), 6);
+  REQUIRE(fields.size() == 2);
+  CHECK(fields[0].dimension == 1);
+  CHECK(fields[1].dimension == 3);
+  CHECK(fields[0].values == std::vector<double>{0.5, 0.25, 0, -0.125, -1e-300, 1.5});
+  CHECK(fields[1].values[10] == -1);
+  auto phi = read_scalar_sol(test::source_path("meshes/fixtures/mshdist_octahedron.sol"), 6);
+  CHECK(phi[3] == -0.125);
+}
+
+TEST_CASE("OBJ, OFF, PLY, STL round trips through OpenMesh") {
+  TempDir dir("io-openmesh");
+  auto mesh = make_sphere({.faces = 500});
+  for (const char* name : {"s.obj", "s.off", "s.ply", "s.stl"}) {
+    CAPTURE(name);
+    write_mesh(mesh, dir / name);
+    auto back = read_mesh(dir / name);
+    REQUIRE(back.n_vertices() == mesh.n_vertices());
+    REQUIRE(back.n_faces() == mesh.n_faces());
+    // STL has no shared vertices (OpenMesh merges them by position, in single precision):
+    // compare the geometry as sets of face corners.
+    double max_error = 0;
+    if (std::string(name) == "s.stl") {
+      for (auto f : back.faces()) {
+        Vec3 c(0, 0, 0);
+        for (auto v : back.fv_range(f)) c += back.point(v);
+        double best = 1e9;
+        for (auto g : mesh.faces()) {
+          Vec3 d(0, 0, 0);
+          for (auto v : mesh.fv_range(g)) d += mesh.point(v);
+          best = std::min(best, (c - d).norm());
+        }
+        max_error = std::max(max_error, best);
+      }
+      CHECK(max_error < 1e-6);
+    } else {
+      // OpenMesh's readers parse coordinates as float: single precision (radius 1).
+      check_identical(mesh, back, false, 1e-7);
+    }
+  }
+}
+
+TEST_CASE("VTU: the appended raw data holds exactly the mesh and fields") {
+  TempDir dir("io-vtu");
+  auto mesh = tagged_sphere(800);
+  VtuFields fields;
+  ScalarField s(mesh.n_vertices());
+  VectorField vel(mesh.n_vertices());
+  std::vector<double> c(mesh.n_faces());
+  for (auto v : mesh.vertices()) s[v.idx()] = 0.5 * v.idx(), vel[v.idx()] = mesh.point(v) * 2.0;
+  for (auto f : mesh.faces()) c[f.idx()] = -1.0 * f.idx();
+  fields.point_scalars.emplace_back("s", s);
+  fields.point_vectors.emplace_back("velocity", vel);
+  fields.cell_scalars.emplace_back("c", c);
+  const auto file = dir / "m.vtu";
+  write_vtu(mesh, file, fields);
+  const std::string text = read_text(file);
+  REQUIRE(contains(text, "header_type=\"UInt64\""));
+  const auto data = text.find("_", text.find("<AppendedData")) + 1;
+  // Decode one DataArray from its offset attribute.
+  auto array = [&](const std::string& name) {
+    auto decl = text.find("Name=\"" + name + "\"");
+    REQUIRE(decl != std::string::npos);
+    auto off = text.find("offset=\"", decl) + 8;
+    std::size_t offset = std::stoull(text.substr(off));
+    std::uint64_t size;
+    std::memcpy(&size, text.data() + data + offset, 8);
+    return text.substr(data + offset + 8, size);
+  };
+  auto as = [](const std::string& raw, auto zero) {
+    std::vector<decltype(zero)> out(raw.size() / sizeof(zero));
+    std::memcpy(out.data(), raw.data(), raw.size());
+    return out;
+  };
+  auto points = as(array("Points"), 0.0);
+  auto connectivity = as(array("connectivity"), std::int64_t());
+  auto offsets = as(array("offsets"), std::int64_t());
+  auto types = array("types");
+  auto region = as(array("region"), std::int32_t());
+  auto quality = as(array("quality"), 0.0);
+  auto phi = as(array("phi"), 0.0);
+  REQUIRE(points.size() == 3 * mesh.n_vertices());
+  REQUIRE(connectivity.size() == 3 * mesh.n_faces());
+  REQUIRE(offsets.size() == mesh.n_faces());
+  CHECK(types == std::string(mesh.n_faces(), char(5)));
+  for (auto v : mesh.vertices()) {
+    for (int k = 0; k < 3; ++k) CHECK(points[3 * v.idx() + k] == mesh.point(v)[k]);
+    CHECK(phi[v.idx()] == mesh.phi(v));
+  }
+  for (auto f : mesh.faces()) {
+    int k = 0;
+    for (auto v : mesh.fv_range(f)) CHECK(connectivity[3 * f.idx() + k++] == v.idx());
+    CHECK(offsets[f.idx()] == 3 * (f.idx() + 1));
+    CHECK(region[f.idx()] == mesh.region(f));
+    CHECK(quality[f.idx()] == face_quality(mesh, f));
+  }
+  CHECK(as(array("s"), 0.0) == s);
+  CHECK(as(array("c"), 0.0) == c);
+  CHECK(as(array("velocity"), 0.0)[3 * 5 + 2] == vel[5][2]);
+}
+
+TEST_CASE("VTU opens in VTK (python3-vtk9, the reader ParaView uses)") {
+  const char* python = "/usr/bin/python3";
+  if (std::system("/usr/bin/python3 -c 'import vtkmodules.vtkIOXML' > /dev/null 2>&1") != 0) {
+    MESSAGE("python3-vtk9 not installed: skipped (scripts/setup.sh installs it)");
+    return;
+  }
+  TempDir dir("io-vtk");
+  auto mesh = tagged_sphere(500);
+  VtuFields fields;
+  VectorField vel(mesh.n_vertices(), Vec3(1, 2, 3));
+  fields.point_vectors.emplace_back("velocity", vel);
+  write_vtu(mesh, dir / "m.vtu", fields);
+  const auto script = dir / "check.py";
+  write_text(script,
+             "import sys\n"
+             "from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader\n"
+             "r = vtkXMLUnstructuredGridReader()\n"
+             "r.SetFileName(sys.argv[1])\n"
+             "r.Update()\n"
+             "g = r.GetOutput()\n"
+             "pd, cd = g.GetPointData(), g.GetCellData()\n"
+             "print(g.GetNumberOfPoints(), g.GetNumberOfCells(), g.GetCellType(0),\n"
+             "      cd.GetArray('region').GetValue(0), '%.17g' % pd.GetArray('phi').GetValue(7),\n"
+             "      pd.GetArray('velocity').GetNumberOfComponents(), '%.17g' % g.GetPoint(3)[2])\n");
+  const auto out = dir / "out.txt";
+  const std::string command =
+      std::string(python) + " " + script.string() + " " + (dir / "m.vtu").string() + " > " + out.string() + " 2>&1";
+  REQUIRE(std::system(command.c_str()) == 0);
+  std::istringstream result(read_text(out));
+  std::size_t points = 0, cells = 0;
+  int type = 0, region = 0, components = 0;
+  double phi7 = 0, z3 = 0;
+  result >> points >> cells >> type >> region >> phi7 >> components >> z3;
+  INFO(read_text(out));
+  CHECK(points == mesh.n_vertices());
+  CHECK(cells == mesh.n_faces());
+  CHECK(type == 5);
+  CHECK(region == mesh.region(FaceHandle(0)));
+  CHECK(phi7 == mesh.phi(VertexHandle(7)));
+  CHECK(components == 3);
+  CHECK(z3 == mesh.point(VertexHandle(3))[2]);
+}
+
+TEST_CASE("PVD: valid after each add, resume keeps the entries up to max_time") {
+  TempDir dir("io-pvd");
+  const auto file = dir / "series.pvd";
+  auto check_valid = [&](std::size_t entries) {
+    const std::string text = read_text(file);
+    CHECK(text.rfind("<?xml", 0) == 0);
+    CHECK(contains(text, "</Collection>\n</VTKFile>\n"));
+    std::size_t count = 0;
+    for (auto p = text.find("<DataSet"); p != std::string::npos; p = text.find("<DataSet", p + 1)) ++count;
+    CHECK(count == entries);
+  };
+  {
+    PvdWriter pvd(file);
+    for (int i = 0; i < 4; ++i) {
+      pvd.add(0.25 * i, "step_" + std::to_string(i) + ".vtu");
+      check_valid(std::size_t(i) + 1);
+    }
+    pvd.add(1.0, "a&b<\"c\">.vtu");  // escaped in XML
+    check_valid(5);
+  }
+  CHECK(contains(read_text(file), "a&amp;b&lt;&quot;c&quot;&gt;.vtu"));
+  {
+    auto pvd = PvdWriter::resume(file, 0.5);
+    CHECK(pvd.size() == 3);
+    check_valid(3);
+    CHECK(!contains(read_text(file), "step_3.vtu"));
+    pvd.add(0.75, "again.vtu");
+    check_valid(4);
+  }
+  auto all = PvdWriter::resume(file, 10);
+  CHECK(all.size() == 4);
+  auto fresh = PvdWriter::resume(dir / "none.pvd", 1);
+  CHECK(fresh.size() == 0);
+  write_text(dir / "bad.pvd", "<VTKFile>\n<Collection>\n<DataSet timestep=\"x1\" file=\"a.vtu\"/>\n");
+  auto message = error_of([&] { PvdWriter::resume(dir / "bad.pvd", 1); });
+  CHECK(contains(message, "bad.pvd:3:"));
+  CHECK(contains(message, "timestep"));
+  CHECK(files_in(dir.path()) == 2);
+}
+
+// ------------------------------------------------------------------------------------------
+// Bad input.
+
+namespace {
+
+const char* kHeader = "MeshVersionFormatted 2\nDimension 3\n";
+const char* kSquareVertices = "Vertices\n4\n0 0 0 0\n1 0 0 0\n1 1 0 0\n0 1 0 0\n";
+
+/// Write `text` to dir/name, read it, and return the error message.
+std::string read_error(const TempDir& dir, const std::string& name, const std::string& text) {
+  write_text(dir / name, text);
+  return error_of([&] { read_mesh(dir / name); });
+}
+
+}  // namespace
+
+TEST_CASE("bad input: missing file, unknown extension") {
+  TempDir dir("io-bad-files");
+  auto m = error_of([&] { read_mesh(dir / "absent.mesh"); });
+  CHECK(contains(m, "absent.mesh"));
+  CHECK(contains(m, "cannot open"));
+  write_text(dir / "x.xyz", "whatever");
+  m = error_of([&] { read_mesh(dir / "x.xyz"); });
+  CHECK(contains(m, "x.xyz"));
+  CHECK(contains(m, "unknown mesh extension '.xyz'"));
+  m = error_of([&] { read_sol(dir / "absent.sol"); });
+  CHECK(contains(m, "absent.sol"));
+  m = error_of([&] { read_mesh(dir / "absent.obj"); });
+  CHECK(contains(m, "absent.obj"));
+}
+
+TEST_CASE("bad input in .mesh text: each error names the file, the line and what was expected") {
+  TempDir dir("io-bad-text");
+  std::string h = kHeader;
+  // Line numbers: the header takes lines 1-2, Vertices 3, count 4, records 5-8.
+  auto m = read_error(dir, "number.mesh", h + "Vertices\n4\n0 0 0 0\n1 0 zero 0\n");
+  CHECK(contains(m, "number.mesh:6:"));
+  CHECK(contains(m, "malformed number 'zero'"));
+  CHECK(contains(m, "z coordinate"));
+
+  m = read_error(dir, "truncated.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 3\n1 3");
+  CHECK(contains(m, "truncated.mesh:12:"));
+  CHECK(contains(m, "unexpected end of file in Triangles (record 2 of 2)"));
+
+  m = read_error(dir, "zero-index.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 3\n0 3 4 3\nEnd\n");
+  CHECK(contains(m, "zero-index.mesh:12:"));
+  CHECK(contains(m, "refers to vertex 0, expected an index in 1..4"));
+
+  m = read_error(dir, "big-index.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 3\n1 3 5 3\nEnd\n");
+  CHECK(contains(m, "big-index.mesh:12:"));
+  CHECK(contains(m, "vertex 5"));
+
+  m = read_error(dir, "nan.mesh", h + "Vertices\n4\n0 0 0 0\n1 0 nan 0\n1 1 0 0\n0 1 0 0\nTriangles\n1\n1 2 3 0\n");
+  CHECK(contains(m, "nan.mesh:6:"));
+  CHECK(contains(m, "NaN or infinite"));
+  m = read_error(dir, "inf.mesh", h + "Vertices\n4\n0 0 0 0\n1 0 0 0\n1 1 0 0\n0 1 -inf 0\nTriangles\n1\n1 2 3 0\n");
+  CHECK(contains(m, "inf.mesh:8:"));
+
+  // Three triangles on edge 1-2.
+  m = read_error(dir, "nm-edge.mesh",
+                 h + "Vertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 -1 0 0\n0 0 1 0\n" +
+                     "Triangles\n3\n1 2 3 0\n2 1 4 0\n1 2 5 0\nEnd\n");
+  CHECK(contains(m, "nm-edge.mesh:14:"));
+  CHECK(contains(m, "non-manifold edge 1-2"));
+
+  // Two triangles touching at vertex 1 only (a bow tie).
+  m = read_error(dir, "nm-vertex.mesh",
+                 h + "Vertices\n5\n0 0 0 0\n1 0 0 0\n1 1 0 0\n-1 0 0 0\n-1 -1 0 0\n" +
+                     "Triangles\n2\n1 2 3 0\n1 4 5 0\nEnd\n");
+  CHECK(contains(m, "nm-vertex.mesh:5:"));
+  CHECK(contains(m, "vertex 1 is non-manifold"));
+
+  m = read_error(dir, "flat.mesh",
+                 h + "Vertices\n4\n0 0 0 0\n1 0 0 0\n2 0 0 0\n0 1 0 0\nTriangles\n2\n1 2 4 0\n1 2 3 0\nEnd\n");
+  CHECK(contains(m, "flat.mesh:12:"));
+  CHECK(contains(m, "triangle 2 has zero area"));
+
+  m = read_error(dir, "dup.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 0\n2 3 1 0\nEnd\n");
+  CHECK(contains(m, "dup.mesh:12:"));
+  CHECK(contains(m, "duplicate"));
+  m = read_error(dir, "dup-flipped.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 0\n1 3 2 0\nEnd\n");
+  CHECK(contains(m, "dup-flipped.mesh:12:"));
+  CHECK(contains(m, "duplicate"));
+
+  m = read_error(dir, "orientation.mesh", h + kSquareVertices + "Triangles\n2\n1 2 3 0\n1 4 3 0\nEnd\n");
+  CHECK(contains(m, "orientation.mesh:12:"));
+  CHECK(contains(m, "inconsistent orientation"));
+
+  m = read_error(dir, "extra.mesh", h + kSquareVertices + "Triangles\n1\n1 2 3 0\n1 3 4 0\nEnd\n");
+  CHECK(contains(m, "extra.mesh:12:"));
+  CHECK(contains(m, "expected a keyword"));
+
+  m = read_error(dir, "ridge.mesh",
+                 h + kSquareVertices + "Triangles\n1\n1 2 3 0\nEdges\n1\n1 2 0\nRidges\n1\n2\nEnd\n");
+  CHECK(contains(m, "ridge.mesh:17:"));
+  CHECK(contains(m, "Ridges entry 1 refers to edge 2"));
+
+  m = read_error(dir, "edge.mesh", h + kSquareVertices + "Triangles\n1\n1 2 3 0\nEdges\n1\n1 4 0\nEnd\n");
+  CHECK(contains(m, "edge.mesh:14:"));
+  CHECK(contains(m, "not a side of any triangle"));
+
+  m = read_error(dir, "huge.mesh", h + "Vertices\n99999999999\n0 0 0 0\n");
+  CHECK(contains(m, "huge.mesh:4:"));
+
+  m = read_error(dir, "version.mesh", "MeshVersionFormatted 7\nDimension 3\n");
+  CHECK(contains(m, "version.mesh:1:"));
+  m = read_error(dir, "empty.mesh", "");
+  CHECK(contains(m, "empty.mesh:1:"));
+  CHECK(contains(m, "MeshVersionFormatted"));
+}
+
+TEST_CASE("bad input in .meshb: errors name the byte offset") {
+  TempDir dir("io-bad-binary");
+  auto good = octahedron_meshb(2, false);
+  std::string bad = good;
+  bad[0] = 7;
+  auto m = read_error(dir, "code.meshb", bad);
+  CHECK(contains(m, "code.meshb: byte 0: bad code word 7"));
+  bad = good;
+  bad[4] = 9;
+  m = read_error(dir, "version.meshb", bad);
+  CHECK(contains(m, "version.meshb: byte 4: unsupported version 9"));
+  // Cut inside the Vertices records: Dimension takes bytes 8-19, Vertices starts at 20, its
+  // count at 28 and its records at 32.
+  m = read_error(dir, "cut.meshb", good.substr(0, 100));
+  CHECK(contains(m, "cut.meshb: byte 20: truncated file"));
+  // A vertex count larger than the data (positions intact).
+  bad = good;
+  std::int32_t many = 100;
+  std::memcpy(&bad[28], &many, 4);
+  m = read_error(dir, "count.meshb", bad);
+  CHECK(contains(m, "count.meshb: byte 32: unexpected end of file"));
+  // A next-keyword position pointing backwards.
+  bad = good;
+  std::int32_t back = 4;
+  std::memcpy(&bad[12], &back, 4);
+  m = read_error(dir, "loop.meshb", bad);
+  CHECK(contains(m, "loop.meshb: byte 8:"));
+  CHECK(contains(m, "next keyword position 4"));
+  // A triangle index out of range, located at its record: triangles start after the header
+  // (8), Dimension (12), Vertices (12 + 6 x 28) and Normals (12 + 24): keyword at 236, records
+  // at 248, 16 bytes each; the second index of triangle 2 is at 248 + 16 + 4.
+  bad = good;
+  std::int32_t seven = 7;
+  std::memcpy(&bad[248 + 16 + 4], &seven, 4);
+  m = read_error(dir, "index.meshb", bad);
+  CHECK(contains(m, "index.meshb: byte 264: triangle 2 refers to vertex 7"));
+}
+
+TEST_CASE("bad input in .sol: count mismatch, wrong kind of field, truncation") {
+  TempDir dir("io-bad-sol");
+  write_scalar_sol(dir / "phi.sol", ScalarField(5, 1.0));
+  auto m = error_of([&] { read_scalar_sol(dir / "phi.sol", 6); });
+  CHECK(contains(m, "phi.sol:5:"));
+  CHECK(contains(m, "SolAtVertices has 5 values per field, but the mesh has 6 vertices"));
+  write_scalar_sol(dir / "phi.solb", ScalarField(5, 1.0));
+  m = error_of([&] { read_scalar_sol(dir / "phi.solb", 4); });
+  CHECK(contains(m, "phi.solb: byte 20:"));
+  m = error_of([&] { read_vector_sol(dir / "phi.sol", 5); });
+  CHECK(contains(m, "expected a vector field"));
+  write_text(dir / "cut.sol", "MeshVersionFormatted 2\nDimension 3\nSolAtVertices\n3\n1 1\n0.5\n0.25\n");
+  m = error_of([&] { read_scalar_sol(dir / "cut.sol", 3); });
+  CHECK(contains(m, "cut.sol:8:"));
+  CHECK(contains(m, "unexpected end of file in SolAtVertices (record 3 of 3)"));
+  write_text(dir / "type.sol", "MeshVersionFormatted 2\nDimension 3\nSolAtVertices\n1\n1 9\n0.5\nEnd\n");
+  m = error_of([&] { read_sol(dir / "type.sol"); });
+  CHECK(contains(m, "type.sol:5:"));
+  CHECK(contains(m, "unknown solution type 9"));
+  write_text(dir / "none.sol", "MeshVersionFormatted 2\nDimension 3\nEnd\n");
+  CHECK(contains(error_of([&] { read_sol(dir / "none.sol"); }), "no SolAtVertices"));
+}
+
+TEST_CASE("bad input through OpenMesh formats: non-manifold input is refused, not repaired") {
+  TempDir dir("io-bad-openmesh");
+  auto m = read_error(dir, "nm.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n");
+  CHECK(contains(m, "nm.off"));
+  CHECK(contains(m, "non-manifold"));
+  m = read_error(dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  CHECK(contains(m, "flat.obj"));
+  CHECK(contains(m, "zero area"));
+  m = read_error(dir, "nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
+  CHECK(contains(m, "nan.obj"));
+}
+
+TEST_CASE("writers: unknown extension or missing directory throws and leaves no file") {
+  TempDir dir("io-bad-write");
+  auto mesh = make_sphere({.faces = 320});
+  auto m = error_of([&] { write_mesh(mesh, dir / "x.unknownext"); });
+  CHECK(contains(m, "x.unknownext"));
+  CHECK(contains(m, "unknown mesh extension"));
+  m = error_of([&] { write_mesh(mesh, dir / "no" / "such" / "x.mesh"); });
+  CHECK(contains(m, "x.mesh"));
+  m = error_of([&] { write_sol(dir / "x.txt", {SolField{"", 1, {1.0}}}); });
+  CHECK(contains(m, "x.txt"));
+  VtuFields wrong;
+  wrong.point_scalars.emplace_back("short", ScalarField(3));
+  m = error_of([&] { write_vtu(mesh, dir / "x.vtu", wrong); });
+  CHECK(contains(m, "field 'short' has 3 values"));
+  CHECK(files_in(dir.path()) == 0);
+}
+
+TEST_CASE("CLI: writing to an unknown extension fails with one clear line and leaves no file") {
+  TempDir dir("io-cli");
+  auto target = dir / "x.unknownext";
+  auto result = test::run_bodyfit("mesh sphere --faces 500 -o " + target.string());
+  INFO(result.output);
+  CHECK(result.exit_code != 0);
+  CHECK(contains(result.output, "x.unknownext"));
+  CHECK(contains(result.output, "unknown mesh extension"));
+  CHECK(files_in(dir.path()) == 0);
+}
