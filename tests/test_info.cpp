@@ -1,0 +1,119 @@
+// `bodyfit info`: the figures it prints for meshes whose answers are known exactly.
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+using bodyfit::test::run_bodyfit;
+using bodyfit::test::TempDir;
+
+namespace {
+
+// The number after `"key": ` (the first occurrence after `from`, if given; for a list, its first).
+double json_value(const std::string& json, const std::string& key, const std::string& from = "") {
+  std::size_t start = from.empty() ? 0 : json.find("\"" + from + "\"");
+  REQUIRE(start != std::string::npos);
+  auto at = json.find("\"" + key + "\": ", start);
+  REQUIRE_MESSAGE(at != std::string::npos, key);
+  at += key.size() + 4;
+  if (json[at] == '[') ++at;
+  return std::strtod(json.c_str() + at, nullptr);
+}
+
+std::string info_json(const std::filesystem::path& mesh) {
+  auto r = run_bodyfit("info --json '" + mesh.string() + "'");
+  REQUIRE(r.exit_code == 0);
+  return r.output;
+}
+
+}  // namespace
+
+TEST_CASE("info: a sphere is one closed component of Euler characteristic 2 and area about 4 pi R^2") {
+  TempDir dir("info_sphere");
+  auto file = dir / "s.mesh";
+  REQUIRE(run_bodyfit("mesh sphere --faces 2420 --radius 2 -o '" + file.string() + "'").exit_code == 0);
+  auto json = info_json(file);
+  CHECK(json_value(json, "faces") == 2420);
+  CHECK(json_value(json, "vertices") == 1212);
+  CHECK(json_value(json, "edges") == 3630);
+  CHECK(json_value(json, "euler_characteristic") == 2);
+  CHECK(json_value(json, "components") == 1);
+  CHECK(json_value(json, "count", "boundary_loops") == 0);
+  const double area = json_value(json, "area");
+  CHECK(area < 16 * M_PI);
+  CHECK(area > 0.99 * 16 * M_PI);
+  CHECK(json_value(json, "min", "quality") >= 0.7);
+  // The box's corners are not on the sphere: its diagonal is at most 2R√3, and close to it.
+  CHECK(json_value(json, "diagonal") <= 4 * std::sqrt(3.0));
+  CHECK(json_value(json, "diagonal") > 0.99 * 4 * std::sqrt(3.0));
+  CHECK(json_value(json, "edges", "interface") == 0);
+}
+
+TEST_CASE("info: a flat terrain is a disc bounded by one loop of length 4 extent") {
+  TempDir dir("info_terrain");
+  auto file = dir / "t.mesh";
+  REQUIRE(run_bodyfit("mesh terrain --extent 10000 --h 500 --seed 3 --max-height 0 -o '" + file.string() + "'")
+              .exit_code == 0);
+  auto json = info_json(file);
+  CHECK(json_value(json, "euler_characteristic") == 1);
+  CHECK(json_value(json, "components") == 1);
+  CHECK(json_value(json, "count", "boundary_loops") == 1);
+  CHECK(json_value(json, "lengths", "boundary_loops") == doctest::Approx(40000).epsilon(1e-12));
+  CHECK(json_value(json, "area") == doctest::Approx(1e8).epsilon(1e-12));
+  CHECK(json_value(json, "corners") == 4);
+
+  // With relief the boundary is longer than the square's perimeter but there is still one loop.
+  auto hilly = dir / "h.mesh";
+  REQUIRE(run_bodyfit("mesh terrain --extent 10000 --h 500 --seed 3 -o '" + hilly.string() + "'").exit_code == 0);
+  auto hj = info_json(hilly);
+  CHECK(json_value(hj, "count", "boundary_loops") == 1);
+  CHECK(json_value(hj, "lengths", "boundary_loops") > 40000);
+  CHECK(json_value(hj, "euler_characteristic") == 1);
+}
+
+TEST_CASE("info: regions, interface and boundary of a hand-made strip") {
+  TempDir dir("info_strip");
+  // [0, 2] × [0, 1]: left unit square inside G (ref 3), right one outside (ref 2), the segment
+  // x = 1 between them is the interface (ref 10).
+  auto file = dir / "strip.mesh";
+  std::ofstream(file) << "MeshVersionFormatted 2\nDimension 3\n"
+                         "Vertices\n6\n0 0 0 0\n1 0 0 0\n2 0 0 0\n0 1 0 0\n1 1 0 0\n2 1 0 0\n"
+                         "Triangles\n4\n1 2 5 3\n1 5 4 3\n2 3 6 2\n2 6 5 2\n"
+                         "Edges\n1\n2 5 10\nEnd\n";
+  auto json = info_json(file);
+  CHECK(json_value(json, "vertices") == 6);
+  CHECK(json_value(json, "faces") == 4);
+  CHECK(json_value(json, "edges") == 9);
+  CHECK(json_value(json, "euler_characteristic") == 1);
+  CHECK(json_value(json, "count", "boundary_loops") == 1);
+  CHECK(json_value(json, "lengths", "boundary_loops") == doctest::Approx(6));
+  CHECK(json_value(json, "length", "interface") == doctest::Approx(1));
+  CHECK(json_value(json, "open_curves", "interface") == 1);
+  CHECK(json_value(json, "closed_curves", "interface") == 0);
+  const auto regions = json.substr(json.find("\"regions\""));
+  CHECK(regions.find("{\"ref\": 2, \"faces\": 2, \"area\": 1}") != std::string::npos);
+  CHECK(regions.find("{\"ref\": 3, \"faces\": 2, \"area\": 1}") != std::string::npos);
+
+  auto text = run_bodyfit("info '" + file.string() + "'");
+  CHECK(text.exit_code == 0);
+  CHECK(text.output.find("region 3") != std::string::npos);
+  CHECK(text.output.find("Euler characteristic 1") != std::string::npos);
+}
+
+TEST_CASE("info: unreadable input is a one-line error with exit code 1") {
+  TempDir dir("info_bad");
+  auto missing = run_bodyfit("info '" + (dir / "missing.mesh").string() + "'");
+  CHECK(missing.exit_code == 1);
+  CHECK(missing.output.find("missing.mesh") != std::string::npos);
+  auto bad = dir / "bad.mesh";
+  std::ofstream(bad) << "MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0\n";
+  auto r = run_bodyfit("info '" + bad.string() + "'");
+  CHECK(r.exit_code == 1);
+  CHECK(r.output.find("bad.mesh") != std::string::npos);
+  CHECK(std::count(r.output.begin(), r.output.end(), '\n') <= 1);
+}
