@@ -8,6 +8,7 @@ PACKAGES=(
   libopenmesh-dev libeigen3-dev libsuitesparse-dev libtet1.5-dev
   libfmt-dev libspdlog-dev doctest-dev libtomlplusplus-dev libcli11-dev libtbb-dev
   libpng-dev libgdal-dev
+  gdal-bin  # gdal_translate: the GeoTIFF test converts an .asc to .tif with it
   python3-vtk9  # tests/test_io.cpp reads the VTU back with VTK (skipped when absent)
 )
 

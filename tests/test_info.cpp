@@ -117,3 +117,25 @@ TEST_CASE("info: unreadable input is a one-line error with exit code 1") {
   CHECK(r.output.find("bad.mesh") != std::string::npos);
   CHECK(std::count(r.output.begin(), r.output.end(), '\n') <= 1);
 }
+
+TEST_CASE("info: a terrain from the DEM fixture covers the raster's extent with one boundary loop") {
+  TempDir dir("info_dem");
+  auto file = dir / "hill.mesh";
+  const auto dem = bodyfit::test::source_path("meshes/dem/hill.asc");
+  auto made = run_bodyfit("mesh terrain --dem '" + dem.string() + "' -o '" + file.string() + "'");
+  REQUIRE(made.exit_code == 0);
+  auto json = info_json(file);
+  CHECK(json_value(json, "euler_characteristic") == 1);
+  CHECK(json_value(json, "components") == 1);
+  CHECK(json_value(json, "count", "boundary_loops") == 1);
+  CHECK(json_value(json, "corners") == 4);
+  // x ∈ [500000, 503000], y ∈ [4000000, 4002000] (30 × 20 cells of 100 m); heights within the raster's.
+  const auto box = json.substr(json.find("\"bounding_box\""));
+  CHECK(box.find("\"min\": [500000, 4000000, ") != std::string::npos);
+  CHECK(box.find("\"max\": [503000, 4002000, ") != std::string::npos);
+  CHECK(json_value(json, "mean", "edge_length") == doctest::Approx(100).epsilon(0.1));
+
+  auto missing = run_bodyfit("mesh terrain --dem '" + (dir / "none.asc").string() + "' -o '" + file.string() + "'");
+  CHECK(missing.exit_code == 1);
+  CHECK(missing.output.find("none.asc") != std::string::npos);
+}
