@@ -1,0 +1,362 @@
+// Advection by characteristics: exact solutions (translation on a plane, expansion along e_β on the
+// sphere, rigid rotation), inflow through an open boundary, paths through vertices and along edges,
+// determinism across thread counts, and the `bodyfit advect` command.
+#include <bodyfit/advection.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
+
+#include <doctest/doctest.h>
+#include <test_support.hpp>
+
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+using namespace bodyfit;
+
+namespace {
+
+/// The unit square [0, 1]² in the plane z = 0, n × n cells, each cut along its (1, 1) diagonal.
+SurfaceMesh make_square(int n) {
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> v;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(double(i) / n, double(j) / n, 0)));
+  auto at = [&](int i, int j) { return v[j * (n + 1) + i]; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+      mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+    }
+  return mesh;
+}
+
+ScalarField sample(const SurfaceMesh& mesh, const std::function<double(const Vec3&)>& f) {
+  ScalarField values(mesh.n_vertices());
+  for (auto v : mesh.vertices()) values[v.idx()] = f(mesh.point(v));
+  return values;
+}
+
+VectorField sample_vector(const SurfaceMesh& mesh, const std::function<Vec3(const Vec3&)>& f) {
+  VectorField values(mesh.n_vertices());
+  for (auto v : mesh.vertices()) values[v.idx()] = f(mesh.point(v));
+  return values;
+}
+
+double polar_angle(const Vec3& p) { return std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0)); }
+
+Vec3 e_beta(const Vec3& p) {
+  const double b = polar_angle(p), a = std::atan2(p[1], p[0]);
+  return Vec3(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), -std::sin(b));
+}
+
+/// Area of {φ < 0} for the P1 interpolant of φ (each face clipped exactly).
+double negative_area(const SurfaceMesh& mesh, const ScalarField& phi) {
+  double area = 0;
+  for (auto f : mesh.faces()) {
+    const auto v = face_vertices(mesh, f);
+    const double full = face_area(mesh, f);
+    int negative = 0;
+    for (auto vh : v) negative += phi[vh.idx()] < 0;
+    if (negative == 0) continue;
+    if (negative == 3) {
+      area += full;
+      continue;
+    }
+    // The lone vertex on one side cuts off a similar corner triangle.
+    const bool lone_negative = negative == 1;
+    int lone = 0;
+    for (int i = 0; i < 3; ++i)
+      if ((phi[v[i].idx()] < 0) == lone_negative) lone = i;
+    const double a = phi[v[lone].idx()], b = phi[v[(lone + 1) % 3].idx()], c = phi[v[(lone + 2) % 3].idx()];
+    const double corner = full * (a / (a - b)) * (a / (a - c));
+    area += lone_negative ? corner : full - corner;
+  }
+  return area;
+}
+
+/// Band error of the e_β expansion on a geodesic sphere of frequency k: φ0 = β − π/4, T = π/4.
+struct BandError {
+  double l2 = 0, h = 0;
+  std::size_t lost = 0;
+};
+BandError expansion_error(int k, bool through_normal_speed, int rk = 2) {
+  const SurfaceMesh mesh = make_sphere({.faces = std::size_t(20 * k * k)});
+  const double a = M_PI / 4, T = M_PI / 4;
+  const ScalarField phi = sample(mesh, [&](const Vec3& p) { return polar_angle(p) - a; });
+  AdvectionOptions options;
+  options.rk_order = rk;
+  AdvectionReport report;
+  const ScalarField result =
+      through_normal_speed
+          ? advect_normal(mesh, phi, ScalarField(mesh.n_vertices(), 1.0), T, options, &report)
+          : advect(mesh, phi, sample_vector(mesh, e_beta), T, options, &report);
+  BandError e;
+  for (auto f : mesh.faces()) {
+    const double third = face_area(mesh, f) / 3;
+    for (auto v : mesh.fv_range(f)) {
+      const double beta = polar_angle(mesh.point(v));
+      if (std::abs(beta - M_PI / 2) >= 0.25) continue;
+      const double error = result[v.idx()] - (beta - a - T);
+      e.l2 += third * error * error;
+    }
+  }
+  e.l2 = std::sqrt(e.l2);
+  e.h = edge_length_stats(mesh).mean;
+  e.lost = report.lost;
+  return e;
+}
+
+/// A cap of angular radius 0.5 centred at polar angle π/3 carried once around the z-axis.
+struct RotationResult {
+  double interface_error = 0;  ///< max |φ(T) − φ0| over the vertices near the interface
+  double area_before = 0, area_after = 0, h = 0;
+  std::size_t lost = 0;
+};
+RotationResult rotate_cap(int k, int rk, double cells = 1.0) {
+  const SurfaceMesh mesh = make_sphere({.faces = std::size_t(20 * k * k)});
+  const Vec3 centre(std::sin(M_PI / 3), 0, std::cos(M_PI / 3));
+  const ScalarField phi = sample(mesh, [&](const Vec3& p) {
+    return std::acos(std::clamp(OpenMesh::dot(p.normalized(), centre), -1.0, 1.0)) - 0.5;
+  });
+  const VectorField velocity = sample_vector(mesh, [](const Vec3& p) { return OpenMesh::cross(Vec3(0, 0, 1), p); });
+  AdvectionOptions options;
+  options.rk_order = rk;
+  options.max_cells_per_substep = cells;
+  AdvectionReport report;
+  const ScalarField result = advect(mesh, phi, velocity, 2 * M_PI, options, &report);
+  RotationResult r;
+  for (std::size_t i = 0; i < phi.size(); ++i)
+    if (std::abs(phi[i]) < 0.1) r.interface_error = std::max(r.interface_error, std::abs(result[i] - phi[i]));
+  r.area_before = negative_area(mesh, phi);
+  r.area_after = negative_area(mesh, result);
+  r.h = edge_length_stats(mesh).mean;
+  r.lost = report.lost;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("translation on a plane reproduces an affine level set exactly, whatever the direction") {
+  // Directions along the horizontal edges, along the diagonals, straight through vertices, and
+  // generic ones; backwards the paths leave through the boundary, where the (affine) boundary values
+  // are also exact.
+  const SurfaceMesh mesh = make_square(20);
+  auto phi0 = [](double x, double y) { return 0.3 + 2 * x - y; };
+  const ScalarField phi = sample(mesh, [&](const Vec3& p) { return phi0(p[0], p[1]); });
+  const std::vector<Vec3> directions = {{1, 0, 0},  {0, 1, 0},   {1, 1, 0},      {-1, -1, 0},
+                                        {2, 1, 0},  {1, 2, 0},   {-2, 1, 0},     {0.37, 0.11, 0},
+                                        {-1, 0, 0}, {0.5, -1, 0}, {-0.23, 0.41, 0}};
+  for (const Vec3& direction : directions) {
+    CAPTURE(direction);
+    const Vec3 V = 0.35 * direction;
+    const double T = 0.8;
+    AdvectionReport report;
+    const ScalarField result = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, {}, &report);
+    CHECK(report.lost == 0);
+    CHECK(report.traced == mesh.n_vertices());
+    double worst = 0;
+    std::size_t leaving = 0;
+    for (auto v : mesh.vertices()) {
+      const Vec3 x = mesh.point(v);
+      // Exact foot: x − sV for the largest s ≤ T that stays in the square.
+      double s = T;
+      for (int c = 0; c < 2; ++c) {
+        if (V[c] > 0) s = std::min(s, x[c] / V[c]);
+        if (V[c] < 0) s = std::min(s, (x[c] - 1) / V[c]);
+      }
+      const Vec3 foot = x - s * V;
+      leaving += s < T;
+      worst = std::max(worst, std::abs(result[v.idx()] - phi0(foot[0], foot[1])));
+    }
+    CHECK(worst < 1e-12);
+    CHECK(report.hit_boundary == leaving);
+  }
+}
+
+TEST_CASE("translation on a plane: a quadratic level set within the P1 interpolation bound") {
+  // For u = |x − c|², I_h u − u = R² − |p − m|² ≤ R² on a triangle of circumradius R (m its
+  // circumcentre): R² = h²/2 on these right triangles.
+  for (int n : {10, 20, 40}) {
+    const SurfaceMesh mesh = make_square(n);
+    const double h = 1.0 / n;
+    auto phi0 = [](double x, double y) { return (x - 0.4) * (x - 0.4) + (y - 0.6) * (y - 0.6) - 0.04; };
+    const ScalarField phi = sample(mesh, [&](const Vec3& p) { return phi0(p[0], p[1]); });
+    const Vec3 V(0.3, -0.2, 0);
+    const double T = 1.0;
+    AdvectionReport report;
+    const ScalarField result = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, {}, &report);
+    CHECK(report.lost == 0);
+    double worst = 0;
+    for (auto v : mesh.vertices()) {
+      const Vec3 foot = mesh.point(v) - T * V;
+      if (foot[0] < 0 || foot[0] > 1 || foot[1] < 0 || foot[1] > 1) continue;
+      worst = std::max(worst, std::abs(result[v.idx()] - phi0(foot[0], foot[1])));
+    }
+    CAPTURE(n);
+    CHECK(worst <= h * h / 2 + 1e-14);
+    CHECK(worst > 0);  // the interpolation error is real: the test can tell
+  }
+}
+
+TEST_CASE("open plane: inflow vertices take the boundary values at the exit point") {
+  const int n = 20;
+  const SurfaceMesh mesh = make_square(n);
+  auto phi0 = [](double x, double y) { return std::sin(3 * y) + x * x; };
+  const ScalarField phi = sample(mesh, [&](const Vec3& p) { return phi0(p[0], p[1]); });
+  // Values on the inflow side x = 0, as P1 along its edges.
+  auto boundary_value = [&](double y) {
+    const double s = y * n;
+    const int j = std::clamp(int(std::floor(s)), 0, n - 1);
+    const double t = s - j;
+    return (1 - t) * phi0(0, double(j) / n) + t * phi0(0, double(j + 1) / n);
+  };
+  for (const Vec3& V : {Vec3(1, 0, 0), Vec3(1, 0.5, 0)}) {
+    CAPTURE(V);
+    const double T = 0.31;  // not a multiple of h: exit points fall inside boundary edges
+    AdvectionReport report;
+    const ScalarField result = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, {}, &report);
+    CHECK(report.lost == 0);
+    std::size_t inflow = 0;
+    double worst = 0;
+    for (auto v : mesh.vertices()) {
+      const Vec3 x = mesh.point(v);
+      double s = T;
+      for (int c = 0; c < 2; ++c)
+        if (V[c] > 0) s = std::min(s, x[c] / V[c]);
+      if (s >= T) continue;
+      const Vec3 foot = x - s * V;
+      if (foot[0] > 1e-12) continue;  // leaves through y = 0, not the side checked here
+      ++inflow;
+      worst = std::max(worst, std::abs(result[v.idx()] - boundary_value(foot[1])));
+    }
+    CHECK(inflow > 0);
+    CHECK(worst < 1e-12);
+  }
+  // Horizontal flow: the bottom and top rows run along boundary edges and must not stop there.
+  AdvectionReport report;
+  advect(mesh, phi, VectorField(mesh.n_vertices(), Vec3(1, 0, 0)), 0.31, {}, &report);
+  std::size_t left_of_T = 0;
+  for (auto v : mesh.vertices()) left_of_T += mesh.point(v)[0] < 0.31;
+  CHECK(report.hit_boundary == left_of_T);
+}
+
+TEST_CASE("sphere: expansion along e_beta converges at order 2 to beta - a - T, nothing lost") {
+  const BandError e11 = expansion_error(11, false), e22 = expansion_error(22, false), e44 = expansion_error(44, false);
+  CHECK(e11.lost + e22.lost + e44.lost == 0);
+  const double order1 = std::log(e11.l2 / e22.l2) / std::log(e11.h / e22.h);
+  const double order2 = std::log(e22.l2 / e44.l2) / std::log(e22.h / e44.h);
+  CAPTURE(e11.l2);
+  CAPTURE(e22.l2);
+  CAPTURE(e44.l2);
+  CHECK(order1 > 1.8);
+  CHECK(order2 > 1.8);
+  // Below the interpolation error scale h²/8 · |band|^(1/2) with |band| ≈ 3.1.
+  CHECK(e44.l2 < e44.h * e44.h / 8 * std::sqrt(3.2));
+}
+
+TEST_CASE("advect_normal with v = 1 on beta - a is the e_beta expansion (grad phi = e_beta)") {
+  for (int k : {11, 22}) {
+    const BandError direct = expansion_error(k, false), normal = expansion_error(k, true);
+    CAPTURE(k);
+    CHECK(normal.lost == 0);
+    // The averaged, normalised vertex gradient is e_β up to O(h²): same accuracy.
+    CHECK(normal.l2 < 1.5 * direct.l2);
+  }
+}
+
+TEST_CASE("rigid rotation about z: one revolution returns the cap") {
+  const RotationResult r11 = rotate_cap(11, 2), r22 = rotate_cap(22, 2), r44 = rotate_cap(44, 2);
+  CHECK(r11.lost + r22.lost + r44.lost == 0);
+  for (const auto& r : {r11, r22, r44}) {
+    CAPTURE(r.h);
+    CAPTURE(r.interface_error);
+    // φ0 is a distance: |φ(T) − φ0| bounds how far the interface moved. O(h²): the P1
+    // interpolation at the foot (≈ h²/8·|∇²φ0|, with |∇²φ0| ≈ cot 0.5 ≈ 1.8 at the interface) plus
+    // the flat faces' O(h²) relative metric error over a path of length up to 2π.
+    MESSAGE("h ", r.h, " interface error ", r.interface_error, " = ", r.interface_error / (r.h * r.h), " h², area ",
+            r.area_before, " -> ", r.area_after);
+    CHECK(r.interface_error < 2 * r.h * r.h);
+    CHECK(std::abs(r.area_after - r.area_before) < 2 * M_PI * r.h * r.h);
+  }
+  CHECK(r22.interface_error < r11.interface_error / 2.5);
+  CHECK(r44.interface_error < r22.interface_error / 2.5);
+}
+
+TEST_CASE("RK4 is at least as accurate as RK2") {
+  // Long sub-steps (4 cells) on curved paths, where the time error shows.
+  const RotationResult rk2 = rotate_cap(22, 2, 4.0), rk4 = rotate_cap(22, 4, 4.0);
+  CHECK(rk2.lost + rk4.lost == 0);
+  CAPTURE(rk2.interface_error);
+  CAPTURE(rk4.interface_error);
+  CHECK(rk4.interface_error <= rk2.interface_error);
+}
+
+TEST_CASE("results do not depend on the thread count") {
+  const SurfaceMesh mesh = make_sphere({.faces = 20 * 22 * 22});
+  const ScalarField phi = sample(mesh, [](const Vec3& p) { return polar_angle(p) - M_PI / 4; });
+  const VectorField velocity = sample_vector(mesh, [](const Vec3& p) { return e_beta(p) + OpenMesh::cross(Vec3(0, 0, 1), p); });
+  ScalarField one, two;
+  AdvectionReport r1, r2;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = advect(mesh, phi, velocity, 0.7, {}, &r1);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = advect(mesh, phi, velocity, 0.7, {}, &r2);
+  }
+  CHECK(one == two);
+  CHECK(r1.substeps == r2.substeps);
+  CHECK(r1.lost == 0);
+}
+
+TEST_CASE("bad input is rejected") {
+  const SurfaceMesh mesh = make_square(2);
+  const ScalarField phi(mesh.n_vertices(), 0.0);
+  const VectorField velocity(mesh.n_vertices(), Vec3(1, 0, 0));
+  CHECK_THROWS_AS(advect(mesh, ScalarField(3, 0.0), velocity, 1.0), InputError);
+  CHECK_THROWS_AS(advect(mesh, phi, VectorField(2), 1.0), InputError);
+  CHECK_THROWS_AS(advect(mesh, phi, velocity, -1.0), InputError);
+  AdvectionOptions rk3;
+  rk3.rk_order = 3;
+  CHECK_THROWS_AS(advect(mesh, phi, velocity, 1.0, rk3), InputError);
+}
+
+TEST_CASE("bodyfit advect: round trip through files on a small sphere") {
+  test::TempDir dir("advect_cli");
+  const SurfaceMesh mesh = make_sphere({.faces = 500});
+  const ScalarField phi = sample(mesh, [](const Vec3& p) { return polar_angle(p) - M_PI / 4; });
+  const VectorField velocity = sample_vector(mesh, e_beta);
+  write_mesh(mesh, dir / "s.mesh");
+  write_scalar_sol(dir / "phi.sol", phi);
+  write_vector_sol(dir / "v.sol", velocity);
+  const auto run = test::run_bodyfit("advect " + (dir / "s.mesh").string() + " --phi " + (dir / "phi.sol").string() +
+                                     " --velocity " + (dir / "v.sol").string() + " --time 0.5 --rk 4 -o " +
+                                     (dir / "out.sol").string());
+  CAPTURE(run.output);
+  REQUIRE(run.exit_code == 0);
+  CHECK(run.output.find("0 lost") != std::string::npos);
+  const ScalarField from_file = read_scalar_sol(dir / "out.sol", mesh.n_vertices());
+  AdvectionOptions options;
+  options.rk_order = 4;
+  const ScalarField direct = advect(read_mesh(dir / "s.mesh"), phi, velocity, 0.5, options);
+  double worst = 0;
+  for (std::size_t i = 0; i < direct.size(); ++i) worst = std::max(worst, std::abs(from_file[i] - direct[i]));
+  CHECK(worst < 1e-12);
+  // And the answer is the expansion's: β − a − T where β > T.
+  double band = 0;
+  for (auto v : mesh.vertices()) {
+    const double beta = polar_angle(mesh.point(v));
+    if (std::abs(beta - M_PI / 2) < 0.25) band = std::max(band, std::abs(from_file[v.idx()] - (beta - M_PI / 4 - 0.5)));
+  }
+  CHECK(band < 0.01);
+
+  const auto missing = test::run_bodyfit("advect " + (dir / "s.mesh").string() + " --phi " +
+                                         (dir / "phi.sol").string() + " --time 1 -o x.sol");
+  CHECK(missing.exit_code != 0);
+}
