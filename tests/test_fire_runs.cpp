@@ -1,0 +1,185 @@
+// The fire plugin inside Algorithm 1, against exact front speeds (paper §4.3).
+#include "balbi.hpp"
+#include "fire_maps.hpp"
+
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/evolution.hpp>
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/plugin_loader.hpp>
+#include <bodyfit/projection.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+using namespace bodyfit;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180;
+
+// A planar terrain z = slope·x over [0, size]², meshed by the DEM path of the generators.
+SurfaceMesh inclined_plane(double size, double h, double slope) {
+  HeightGrid grid;
+  grid.cell_size = h;
+  grid.cols = grid.rows = std::size_t(size / h) + 1;
+  grid.heights.resize(grid.cols * grid.rows);
+  for (std::size_t r = 0; r < grid.rows; ++r)
+    for (std::size_t c = 0; c < grid.cols; ++c) grid.heights[r * grid.cols + c] = slope * ((double(c) + 0.5) * h);
+  return make_terrain_from_grid(grid, h);
+}
+
+struct FireRun {
+  SurfaceMesh mesh;
+  EvolutionResult result;
+};
+
+// Burn disks (x, y, r in plan view) for `steps` steps of `dt` with the fire model configured by `toml_text`.
+FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disks, const std::string& toml_text,
+             double dt, int steps, const std::filesystem::path& output_dir = {}, double hausd = 0) {
+  ScalarField phi(surface.n_vertices());
+  for (auto v : surface.vertices()) {
+    double best = std::numeric_limits<double>::infinity();
+    for (auto& d : disks) best = std::min(best, std::hypot(surface.point(v)[0] - d[0], surface.point(v)[1] - d[1]) - d[2]);
+    phi[v.idx()] = best;
+  }
+  RemeshOptions remesh;
+  remesh.hmax = edge_length_stats(surface).mean;
+  remesh.hausd = hausd;
+  remesh.reference = std::make_shared<ReferenceSurface>(surface);
+  mesh_initial_region(surface, phi, {}, remesh);
+
+  LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
+  configure_model(model, toml::parse(toml_text));
+  EvolutionOptions options;
+  options.dt = dt;
+  options.max_iterations = steps;
+  options.remesh = remesh;
+  options.terrain = true;
+  options.log = false;
+  options.output_dir = output_dir;
+  FireRun run;
+  run.result = evolve(surface, model.model(), options);
+  if (!output_dir.empty()) model->finish(output_dir);
+  run.mesh = std::move(surface);
+  return run;
+}
+
+// An ESRI ASCII grid read as written (the DEM reader fills NODATA cells, which an arrival map must keep).
+HeightGrid read_raw_grid(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  HeightGrid g;
+  std::string key;
+  double value;
+  for (int i = 0; i < 6 && in >> key >> value; ++i) {
+    if (key == "ncols") g.cols = std::size_t(value);
+    if (key == "nrows") g.rows = std::size_t(value);
+    if (key == "xllcorner") g.x_origin = value;
+    if (key == "yllcorner") g.y_origin = value;
+    if (key == "cellsize") g.cell_size = value;
+    if (key == "NODATA_value") g.nodata = value;
+  }
+  g.heights.resize(g.cols * g.rows);
+  for (double& h : g.heights) in >> h;
+  return g;
+}
+
+// Extent of G along x: the interface vertices' min and max x.
+std::pair<double, double> front_x_extent(const SurfaceMesh& mesh) {
+  double lo = 1e300, hi = -1e300;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e))
+      for (int i = 0; i < 2; ++i) {
+        double x = mesh.point(mesh.to_vertex_handle(mesh.halfedge_handle(e, i)))[0];
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+      }
+  return {lo, hi};
+}
+
+}  // namespace
+
+TEST_CASE("flat ground, no wind: a disk grows at exactly R0") {
+  const double R0 = fire::BalbiParameters{}.R0;
+  const double r0 = 150, dt = 20;  // 8 m per step, edge 20 m
+  FireRun run = burn(inclined_plane(1200, 20, 0), {{600, 600, r0}}, "preset = 'balbi2009'", dt, 50, {}, 0.05);
+  double t = run.result.time;
+  CHECK(t == doctest::Approx(50 * dt));
+  double radius = std::sqrt(region_area(run.mesh, kInside) / M_PI);
+  double exact = r0 + R0 * t;
+  INFO("radius " << radius << " exact " << exact);
+  CHECK(std::abs(radius - exact) / exact < 0.01);
+}
+
+TEST_CASE("inclined plane, no wind: the head runs uphill at R(alpha), the back at R0") {
+  fire::BalbiParameters p;
+  const double alpha = 20 * kDeg, slope = std::tan(alpha);
+  const double r0 = 150, dt = 10, steps = 40;
+  FireRun run = burn(inclined_plane(1600, 20, slope), {{700, 800, r0}}, "", dt, int(steps), {}, 0.05);
+  double t = run.result.time;
+  auto [x_back, x_head] = front_x_extent(run.mesh);
+  // Distances along the surface: horizontal / cos α.
+  double head = (x_head - 700) / std::cos(alpha) - r0 / std::cos(alpha);
+  double back = (700 - x_back) / std::cos(alpha) - r0 / std::cos(alpha);
+  double head_exact = fire::rate_of_spread(alpha, p) * t, back_exact = p.R0 * t;
+  INFO("head " << head << " exact " << head_exact << "; back " << back << " exact " << back_exact);
+  CHECK(head == doctest::Approx(head_exact).epsilon(0.02));
+  CHECK(back == doctest::Approx(back_exact).epsilon(0.03));
+}
+
+TEST_CASE("uniform wind on flat ground: the head moves at R(atan(|U|/u0))") {
+  fire::BalbiParameters p;
+  const double wind = 15;  // m/s along +x
+  const double r0 = 150, dt = 10;
+  FireRun run = burn(inclined_plane(1600, 20, 0), {{500, 800, r0}},
+                     "[wind]\ntype = 'uniform'\nvelocity = [15.0, 0.0]\n", dt, 40, {}, 0.05);
+  double t = run.result.time;
+  auto [x_back, x_head] = front_x_extent(run.mesh);
+  double head_exact = fire::rate_of_spread(std::atan(wind / p.u0), p) * t;
+  INFO("head advance " << x_head - 500 - r0 << " exact " << head_exact);
+  CHECK(x_head - 500 - r0 == doctest::Approx(head_exact).epsilon(0.02));
+  CHECK(500 - r0 - x_back == doctest::Approx(p.R0 * t).epsilon(0.03));
+}
+
+TEST_CASE("four fires merge into one burnt region") {
+  const double R0 = fire::BalbiParameters{}.R0;
+  // Disks of 80 m, centres 300 m apart: they touch after (150 − 80)/R0 ≈ 176 s.
+  FireRun run = burn(inclined_plane(1000, 20, 0), {{350, 350, 80}, {650, 350, 80}, {350, 650, 80}, {650, 650, 80}},
+                     "", 20, 15);
+  REQUIRE(run.result.records.size() == 15);
+  CHECK(run.result.records.front().components == 4);
+  CHECK(run.result.records.back().components == 1);
+  CHECK(run.result.time * R0 > 150 - 80);
+}
+
+TEST_CASE("a run on a DEM read from an ESRI ASCII grid writes arrival times") {
+  test::TempDir dir("fire_dem");
+  // A small hill: z = 100·exp(−r²/300²) on a 41×41 raster of 25 m.
+  {
+    std::ofstream out(dir / "hill.asc");
+    out << "ncols 41\nnrows 41\nxllcorner 0\nyllcorner 0\ncellsize 25\nNODATA_value -9999\n";
+    for (int r = 0; r < 41; ++r) {
+      for (int c = 0; c < 41; ++c) {
+        double x = (c + 0.5) * 25 - 512.5, y = (40 - r + 0.5) * 25 - 512.5;
+        out << 100 * std::exp(-(x * x + y * y) / (300.0 * 300.0)) << (c < 40 ? " " : "\n");
+      }
+    }
+  }
+  SurfaceMesh terrain = make_terrain_from_grid(read_esri_ascii(dir / "hill.asc"), 25);
+  FireRun run = burn(std::move(terrain), {{300, 300, 100}}, "[arrival]\ncell_size = 25.0\n", 30, 10, dir.path());
+  REQUIRE(run.result.records.size() == 10);
+  CHECK(run.result.records.back().area > run.result.records.front().area);
+  HeightGrid arrival = read_raw_grid(dir / "arrival_time.asc");
+  // Cells inside the initial disk arrive at 0, cells far away are never reached, and arrival
+  // times grow away from the ignition point.
+  CHECK(fire::raster_nearest(arrival, 300, 300) == doctest::Approx(0.0));
+  double near = fire::raster_nearest(arrival, 300, 420);  // 20 m beyond the initial front
+  CHECK(near > 0);
+  CHECK(near < run.result.time);
+  CHECK(fire::raster_nearest(arrival, 1000, 1000) == arrival.nodata);
+}
