@@ -83,8 +83,9 @@ struct alignas(64) Face {
   /// the slot of this face's corner (i + 1) % 3 (the third slot holds corner (i + 2) % 3).
   unsigned char across[3];
   float size;        ///< mean edge length: sets the sub-step
+  double altitude[3];  ///< 1/|∇λ_i|: the unfolding needs unit directions, without a square root
 };
-static_assert(sizeof(Face) == 192);  // 187 bytes of data
+static_assert(sizeof(Face) == 256);  // 211 bytes of data
 
 
 struct Surface {
@@ -120,7 +121,11 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
       }
       const auto g = p1_basis_gradients(mesh.point(VertexHandle(corner[0])), mesh.point(VertexHandle(corner[1])),
                                         mesh.point(VertexHandle(corner[2])));
-      for (int i = 0; i < 3; ++i) f.grad[i] = from(g[i]);
+      for (int i = 0; i < 3; ++i) {
+        f.grad[i] = from(g[i]);
+        const double len = norm(f.grad[i]);
+        f.altitude[i] = len > 0 ? 1.0 / len : 0.0;
+      }
       V3 n = cross(p[1] - p[0], p[2] - p[0]);
       const double nn = norm(n);
       const V3 normal = f.normal = nn > 0 ? (1.0 / nn) * n : V3{};
@@ -228,8 +233,8 @@ WalkEnd walk(const Surface& s, Location& at, V3 d, M3* rotation) {
     // (∇λ of g's corner opposite the edge, normalised); e = u1 × n1 is the edge direction.
     const int jo = f.across[exit] & 3, jn = f.across[exit] >> 2;
     const V3 n1 = f.normal, n2 = fg.normal;
-    const V3 u1 = (-1.0 / norm(f.grad[exit])) * f.grad[exit];
-    const V3 u2 = (1.0 / norm(fg.grad[jo])) * fg.grad[jo];
+    const V3 u1 = (-f.altitude[exit]) * f.grad[exit];
+    const V3 u2 = fg.altitude[jo] * fg.grad[jo];
     const V3 e = cross(u1, n1);
     d = dot(d, e) * e + dot(d, u1) * u2 + dot(d, n1) * n2;
     if (rotation) compose_unfolding(*rotation, e, u1, n1, u2, n2);
@@ -271,46 +276,48 @@ TraceResult trace(const Surface& s, Location start, double T,
   };
   for (int o = 0; o < outer; ++o) {
     double remaining = outer_dt;
+    double dt = 0;  // kept from one sub-step to the next while it still fits (no square root, no division)
     while (remaining > 0) {
       const V3 k1 = velocity_at(s, x);
       const double speed2 = dot(k1, k1);
-      double dt = remaining;
       const double reach = opt.max_cells_per_substep * s.faces[x.face].size;
-      if (speed2 * remaining * remaining > reach * reach) {
+      if (dt == 0 || speed2 * dt * dt > 1.5625 * reach * reach) {  // (1.25 reach)²
         // Equal sub-steps over what remains, each crossing about `reach`.
-        const double n = std::ceil(std::sqrt(speed2) * remaining / reach);
-        dt = remaining / n;
+        dt = speed2 * remaining * remaining > reach * reach ? remaining / std::ceil(std::sqrt(speed2) * remaining / reach)
+                                                            : remaining;
       }
-      remaining = dt >= remaining ? 0.0 : remaining - dt;
+      if (dt >= remaining * (1 - 1e-12)) dt = remaining;  // no sliver of a last step
+      remaining = dt == remaining ? 0.0 : remaining - dt;
       ++r.substeps;
-      V3 step;
-      bool ok = true;
       if (opt.rk_order == 4) {
         V3 k2, k3, k4;
-        ok = stage(x, (-0.5 * dt) * k1, k2) && stage(x, (-0.5 * dt) * k2, k3) && stage(x, (-dt) * k3, k4);
-        step = (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        if (!stage(x, (-0.5 * dt) * k1, k2) || !stage(x, (-0.5 * dt) * k2, k3) || !stage(x, (-dt) * k3, k4)) {
+          r.stalled = true;
+          break;
+        }
+        const WalkEnd end = walk(s, x, (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4), nullptr);
+        if (end != WalkEnd::arrived) {
+          (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
+          break;
+        }
       } else {
-        V3 k2;
-        ok = stage(x, (-0.5 * dt) * k1, k2);
-        step = (-dt) * k2;
-      }
-      if (!ok) {
-        r.stalled = true;
-        r.foot = x;
-        return r;
-      }
-      const WalkEnd end = walk(s, x, step, nullptr);
-      if (end == WalkEnd::stalled) {
-        r.stalled = true;
-        r.foot = x;
-        return r;
-      }
-      if (end == WalkEnd::boundary) {
-        r.boundary = true;
-        r.foot = x;
-        return r;
+        // Midpoint rule, x ← x − dt·V(x − dt/2·V(x)). The walk goes on from the midpoint y rather
+        // than restarting from x: the remaining displacement, −dt·V(y) + dt/2·V(x), is expressed in
+        // y's face through the unfolding rotation of the first half. Where both walks would cross
+        // the same faces the end point is the same, and the walked length drops from 1.5 to 1.
+        M3 rotation;
+        WalkEnd end = walk(s, x, (-0.5 * dt) * k1, &rotation);
+        if (end == WalkEnd::arrived) {
+          const V3 k2 = velocity_at(s, x);
+          end = walk(s, x, (-dt) * k2 + (0.5 * dt) * rotation.apply(k1), nullptr);
+        }
+        if (end != WalkEnd::arrived) {
+          (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
+          break;
+        }
       }
     }
+    if (r.boundary || r.stalled) break;
   }
   r.foot = x;
   return r;
