@@ -603,38 +603,38 @@ int written_edge_ref(const SurfaceMesh& mesh, EdgeHandle e) {
 void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostream& stream) {
   OutputBuffer out(stream);
   auto& b = out.text();
-  fmt::format_to(std::back_inserter(b), "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}\n", c.vertices.size());
+  fmt::format_to(fmt::appender(b), "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}\n", c.vertices.size());
   for (auto v : c.vertices) {
     const auto& p = mesh.point(v);
     // {} is the shortest representation that reads back to the same double.
-    fmt::format_to(std::back_inserter(b), "{} {} {} {}\n", p[0], p[1], p[2], mesh.vertex_ref(v));
+    fmt::format_to(fmt::appender(b), "{} {} {} {}\n", p[0], p[1], p[2], mesh.vertex_ref(v));
     out.maybe_flush();
   }
-  fmt::format_to(std::back_inserter(b), "\nTriangles\n{}\n", c.faces.size());
+  fmt::format_to(fmt::appender(b), "\nTriangles\n{}\n", c.faces.size());
   for (auto f : c.faces) {
     auto h = mesh.halfedge_handle(f);
     auto v0 = mesh.to_vertex_handle(h);
     h = mesh.next_halfedge_handle(h);
     auto v1 = mesh.to_vertex_handle(h);
     auto v2 = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-    fmt::format_to(std::back_inserter(b), "{} {} {} {}\n", c.vertex_index[v0.idx()] + 1, c.vertex_index[v1.idx()] + 1,
+    fmt::format_to(fmt::appender(b), "{} {} {} {}\n", c.vertex_index[v0.idx()] + 1, c.vertex_index[v1.idx()] + 1,
                    c.vertex_index[v2.idx()] + 1, mesh.region(f));
     out.maybe_flush();
   }
   if (!c.edges.empty()) {
-    fmt::format_to(std::back_inserter(b), "\nEdges\n{}\n", c.edges.size());
+    fmt::format_to(fmt::appender(b), "\nEdges\n{}\n", c.edges.size());
     for (auto e : c.edges) {
       auto h = mesh.halfedge_handle(e, 0);
-      fmt::format_to(std::back_inserter(b), "{} {} {}\n", c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1,
+      fmt::format_to(fmt::appender(b), "{} {} {}\n", c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1,
                      c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1, written_edge_ref(mesh, e));
       out.maybe_flush();
     }
   }
   auto list = [&](const char* name, const std::vector<std::int64_t>& items) {
     if (items.empty()) return;
-    fmt::format_to(std::back_inserter(b), "\n{}\n{}\n", name, items.size());
+    fmt::format_to(fmt::appender(b), "\n{}\n{}\n", name, items.size());
     for (auto i : items) {
-      fmt::format_to(std::back_inserter(b), "{}\n", i);
+      fmt::format_to(fmt::appender(b), "{}\n", i);
       out.maybe_flush();
     }
   };
@@ -642,7 +642,7 @@ void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostre
   list("RequiredEdges", c.required_edges);
   list("Corners", c.corners);
   list("RequiredVertices", c.required_vertices);
-  fmt::format_to(std::back_inserter(b), "\nEnd\n");
+  fmt::format_to(fmt::appender(b), "\nEnd\n");
   out.flush();
 }
 
@@ -917,21 +917,21 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
     io_detail::OutputBuffer out(stream);
     if (ext == ".sol") {
       auto& b = out.text();
-      fmt::format_to(std::back_inserter(b), "MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n{}\n{}", n,
+      fmt::format_to(fmt::appender(b), "MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n{}\n{}", n,
                      fields.size());
-      for (int t : types) fmt::format_to(std::back_inserter(b), " {}", t);
+      for (int t : types) fmt::format_to(fmt::appender(b), " {}", t);
       b.push_back('\n');
       for (std::size_t i = 0; i < n; ++i) {
         const char* separator = "";
         for (const auto& f : fields)
           for (int k = 0; k < f.dimension; ++k) {
-            fmt::format_to(std::back_inserter(b), "{}{}", separator, f.values[i * std::size_t(f.dimension) + std::size_t(k)]);
+            fmt::format_to(fmt::appender(b), "{}{}", separator, f.values[i * std::size_t(f.dimension) + std::size_t(k)]);
             separator = " ";
           }
         b.push_back('\n');
         out.maybe_flush();
       }
-      fmt::format_to(std::back_inserter(b), "\nEnd\n");
+      fmt::format_to(fmt::appender(b), "\nEnd\n");
     } else {
       std::uint64_t per_vertex = 0;
       for (const auto& f : fields) per_vertex += std::uint64_t(f.dimension);
