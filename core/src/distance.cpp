@@ -47,7 +47,8 @@ double triangle_update(const CornerGeometry& g, double da, double db) {
 /// splits the angle into two acute ones, with the geometry of the virtual triangles (x; a, r) and
 /// (x; r, b).
 struct ObtuseSplit {
-  int vertex = -1;
+  int corner = -1;  ///< 3f + c of the obtuse corner
+  int vertex = -1;  ///< r
   CornerGeometry first, second;
 };
 
@@ -69,6 +70,7 @@ struct FlatMesh {
   std::vector<int> across;          // 3f + c → face across the edge opposite corner c, or −1
   std::vector<int> obtuse;          // 3f + c → index into splits, −2 obtuse without split, −1 not obtuse
   std::vector<ObtuseSplit> splits;
+  std::vector<int> split_start, split_list;  // vertex r → the splits that use it (CSR)
   std::vector<int> fan_start;       // vertex → its fan triangles (CSR)
   std::vector<FanTriangle> fan;
 };
@@ -101,6 +103,13 @@ FlatMesh flatten(const SurfaceMesh& mesh) {
 
 /// The fans, after the obtuse corners are known.
 void build_fans(FlatMesh& m) {
+  m.split_start.assign(m.nv + 1, 0);
+  for (const auto& s : m.splits) ++m.split_start[s.vertex + 1];
+  for (std::size_t i = 0; i < m.nv; ++i) m.split_start[i + 1] += m.split_start[i];
+  m.split_list.resize(m.splits.size());
+  std::vector<int> next(m.split_start.begin(), m.split_start.end() - 1);
+  for (std::size_t i = 0; i < m.splits.size(); ++i) m.split_list[next[m.splits[i].vertex]++] = int(i);
+
   m.fan_start.assign(m.nv + 1, 0);
   for (int v : m.corner_vertex) ++m.fan_start[v + 1];
   for (std::size_t i = 0; i < m.nv; ++i) m.fan_start[i + 1] += m.fan_start[i];
@@ -166,6 +175,7 @@ void split_obtuse_corner(FlatMesh& m, int k) {
     if (acute_a && acute_b) {
       const Vec3 ea3{A0[0], A0[1], 0}, eb3{B0[0], B0[1], 0}, er3{R[0], R[1], 0};
       ObtuseSplit s;
+      s.corner = k;
       s.vertex = rv;
       s.first = corner_geometry(ea3, er3);
       s.second = corner_geometry(er3, eb3);
@@ -283,6 +293,9 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m) {
   return s;
 }
 
+constexpr int kNearRings = 4;
+constexpr double kNearRadius = 3;
+
 using HeapEntry = std::pair<double, int>;
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<>>;
 
@@ -297,8 +310,9 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
   // Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
   // segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
   // this differs from the geodesic distance by O(h³), far below the O(h²) of the P1 zero set.
-  // The vertices one and two rings further get the same direct distance as a tentative value (the
-  // march may still lower it), which keeps the near field second-order accurate.
+  // The vertices up to kNearRings rings further get the same direct distance: final where it is
+  // below kNearRadius shortest edges (every interface point that close lies in a seed face within
+  // those rings), tentative beyond. This keeps the near field second-order accurate.
   std::vector<int> stamp(nv, -1);
   std::vector<int> ring;
   for (std::size_t i = 0; i < seeds.faces.size(); ++i) {
@@ -310,7 +324,7 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
       ring.push_back(u);
       state[u] = 2;
     }
-    for (int depth = 0, begin = 0; depth < 3; ++depth) {  // up to 3 rings around the face
+    for (int depth = 0, begin = 0; depth < kNearRings; ++depth) {
       const int end = int(ring.size());
       for (int r = begin; r < end; ++r)
         for (int j = m.fan_start[ring[r]]; j < m.fan_start[ring[r] + 1]; ++j)
@@ -334,18 +348,27 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
     if (seeds.sign[v] == 0) dist[v] = 0;
     if (dist[v] == kInf) continue;
     if (state[v] == 0) {
-      // Every interface point within Euclidean distance 2·(shortest edge at v) lies in a seed face
-      // within 3 rings of v, so a direct distance below that bound is final.
       double shortest = kInf;
       for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
         shortest = std::min(shortest, (m.points[m.fan[j].a] - m.points[v]).sqrnorm());
-      state[v] = dist[v] * dist[v] <= 4 * shortest ? 2 : 1;
+      state[v] = dist[v] * dist[v] <= kNearRadius * kNearRadius * shortest ? 2 : 1;
     }
     if (state[v] == 2) ++report.initialised;
     heap.emplace(dist[v], int(v));
   }
 
   auto known = [&](int v) { return state[v] >= 2; };
+  // Update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
+  auto split_update = [&](int split) {
+    const ObtuseSplit& s = m.splits[split];
+    double value = kInf;
+    if (!known(s.vertex)) return value;
+    const int f = s.corner / 3, c = s.corner % 3;
+    const int a = m.corner_vertex[3 * f + (c + 1) % 3], b = m.corner_vertex[3 * f + (c + 2) % 3];
+    if (known(a)) value = std::min(value, triangle_update(s.first, dist[a], dist[s.vertex]));
+    if (known(b)) value = std::min(value, triangle_update(s.second, dist[s.vertex], dist[b]));
+    return value;
+  };
   while (!heap.empty()) {
     const auto [d, v] = heap.top();
     heap.pop();
@@ -366,16 +389,8 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
         if (!(t.obtuse & (1 << side))) {
           if (known(y)) value = triangle_update(corner_geometry(ev, m.points[y] - px), d, dist[y]);
         } else {  // obtuse angle at x: the two acute virtual triangles of the unfolding
-          const int f = t.corner / 3, cx = (t.corner % 3 + 1 + side) % 3;
-          const int split = m.obtuse[3 * f + cx];
-          if (split >= 0) {
-            const ObtuseSplit& s = m.splits[split];
-            const int a = m.corner_vertex[3 * f + (cx + 1) % 3], b = m.corner_vertex[3 * f + (cx + 2) % 3];
-            if (known(s.vertex)) {
-              if (known(a)) value = std::min(value, triangle_update(s.first, dist[a], dist[s.vertex]));
-              if (known(b)) value = std::min(value, triangle_update(s.second, dist[s.vertex], dist[b]));
-            }
-          }
+          const int split = m.obtuse[3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3];
+          if (split >= 0) value = split_update(split);
         }
         if (value == kInf) value = d + ev.norm();
         if (value < dist[x]) {
@@ -383,6 +398,18 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
           state[x] = 1;
           heap.emplace(value, x);
         }
+      }
+    }
+    // v may be the unfolded vertex r of obtuse corners elsewhere: update those corners too.
+    for (int j = m.split_start[v]; j < m.split_start[v + 1]; ++j) {
+      const int split = m.split_list[j];
+      const int x = m.corner_vertex[m.splits[split].corner];
+      if (known(x)) continue;
+      const double value = split_update(split);
+      if (value < dist[x]) {
+        dist[x] = value;
+        state[x] = 1;
+        heap.emplace(value, x);
       }
     }
   }
