@@ -115,24 +115,10 @@ int run_case(const RunArguments& args) {
   spdlog::info("model '{}' ({})", model->name(), model.file().string());
 
   // S and its fixed reference, then T^0 (rebuilt on --resume too: it gives h for the CFL step).
-  SurfaceMesh mesh = make_case_surface(config);
-  mesh.garbage_collection();
-  EvolutionOptions options;
-  options.remesh = config.remesh;
-  options.remesh.reference = make_case_reference(config, mesh);
-  if (config.region.kind == RegionSpec::Kind::Refs) {
-    label_from_refs(config, mesh);
-    remesh(mesh, options.remesh);
-  } else {
-    mesh_initial_region(mesh, initial_level_set(config, mesh), config.discretize, options.remesh);
-  }
-  const double h = config.remesh.hmax > 0 ? config.remesh.hmax : mean_edge_length(mesh);
-  options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * h;
-  options.final_time = config.time.final_time;
-  options.max_iterations = config.time.iterations;
-  options.distance = config.distance;
-  options.advection = config.advection;
-  options.discretize = config.discretize;
+  CaseSetup setup = setup_case(config);
+  SurfaceMesh& mesh = setup.mesh;
+  EvolutionOptions& options = setup.options;
+  const double h = setup.h;
   options.output_dir = outdir;
   options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
   options.stop = &g_interrupted;

@@ -295,21 +295,46 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
         out.refs.clear();
         for (double r : s.numbers("refs", 0)) out.refs.push_back(int(r));
       }
-      s.forbid({"sol", "axis", "angle", "center", "centers", "radii"}, "to shape 'refs'");
+      s.forbid({"sol", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'refs'");
     } else if (shape == "sol") {
       out.kind = RegionSpec::Kind::Sol;
       if (!s.has("sol")) s.fail("shape 'sol': missing key 'sol' (the φ file)");
       out.sol = resolve(s.string("sol", ""));
-      s.forbid({"refs", "axis", "angle", "center", "centers", "radii"}, "to shape 'sol'");
+      s.forbid({"refs", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'sol'");
     } else if (shape == "cap") {
       out.kind = RegionSpec::Kind::Cap;
-      if (auto axis = s.numbers("axis", 3); !axis.empty()) out.axis = to_vec3(axis);
-      if (!(out.axis.norm() > 0)) s.fail("axis: must not be zero");
-      out.axis.normalize();
       if (auto center = s.numbers("center", 3); !center.empty()) out.center = to_vec3(center);
-      if (!s.has("angle")) s.fail("shape 'cap': missing key 'angle' (polar angle in degrees)");
-      out.angle = s.number("angle", 45);
-      if (!(out.angle > 0 && out.angle < 180)) s.fail("angle: must be in (0, 180) degrees");
+      if (s.has("axes") || s.has("angles")) {
+        // A union of caps.
+        if (s.has("axis") || s.has("angle")) s.fail("give either axis/angle or axes/angles");
+        const auto* axes_node = s.node("axes");
+        auto angles = s.numbers("angles", 0);
+        const auto* axes = axes_node ? axes_node->as_array() : nullptr;
+        if (!axes) s.fail("shape 'cap': 'axes' = [[x, y, z], ...] must go with 'angles'");
+        if (axes->size() != angles.size() || angles.empty())
+          s.fail(fmt::format("axes and angles: {} axes but {} angles", axes->size(), angles.size()));
+        for (std::size_t i = 0; i < angles.size(); ++i) {
+          const auto* a = (*axes)[i].as_array();
+          if (!a || a->size() != 3) s.type_error("axes", "an array of [x, y, z] axes");
+          Vec3 axis;
+          for (int k = 0; k < 3; ++k) {
+            auto c = (*a)[std::size_t(k)].value<double>();
+            if (!c) s.type_error("axes", "an array of [x, y, z] axes");
+            axis[k] = *c;
+          }
+          if (!(axis.norm() > 0)) s.fail("axes: must not be zero");
+          if (!(angles[i] > 0 && angles[i] < 180)) s.fail("angles: each must be in (0, 180) degrees");
+          out.caps.emplace_back(axis.normalized(), angles[i]);
+        }
+      } else {
+        if (auto axis = s.numbers("axis", 3); !axis.empty()) out.axis = to_vec3(axis);
+        if (!(out.axis.norm() > 0)) s.fail("axis: must not be zero");
+        out.axis.normalize();
+        if (!s.has("angle")) s.fail("shape 'cap': missing key 'angle' (polar angle in degrees)");
+        out.angle = s.number("angle", 45);
+        if (!(out.angle > 0 && out.angle < 180)) s.fail("angle: must be in (0, 180) degrees");
+        out.caps.emplace_back(out.axis, out.angle);
+      }
       s.forbid({"refs", "sol", "centers", "radii"}, "to shape 'cap'");
     } else {
       out.kind = RegionSpec::Kind::Disks;
@@ -327,7 +352,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
         if (!(radii[i] > 0)) s.fail("radii: must be > 0");
         out.disks.push_back({*(*pair)[0].value<double>(), *(*pair)[1].value<double>(), radii[i]});
       }
-      s.forbid({"refs", "sol", "axis", "angle", "center"}, "to shape 'disks'");
+      s.forbid({"refs", "sol", "axis", "angle", "axes", "angles", "center"}, "to shape 'disks'");
     }
     s.check_unknown();
   }
@@ -451,12 +476,16 @@ ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surfa
       return read_scalar_sol(r.sol, surface.n_vertices());
     case RegionSpec::Kind::Cap: {
       // Geodesic distance on a sphere of radius R: R·(polar angle − cap angle).
-      const double a = r.angle * std::numbers::pi / 180;
+      // For a union, the distance to the union is the min of the distances (exact outside).
       for (auto v : surface.vertices()) {
         Vec3 p = surface.point(v) - r.center;
         double radius = p.norm();
-        double beta = std::atan2(cross(p, r.axis).norm(), dot(p, r.axis));
-        phi[v.idx()] = radius * (beta - a);
+        double value = std::numeric_limits<double>::infinity();
+        for (const auto& [axis, angle] : r.caps) {
+          double beta = std::atan2(cross(p, axis).norm(), dot(p, axis));
+          value = std::min(value, radius * (beta - angle * std::numbers::pi / 180));
+        }
+        phi[v.idx()] = value;
       }
       return phi;
     }
@@ -479,6 +508,31 @@ std::shared_ptr<const ReferenceSurface> make_case_reference(const CaseConfig& co
   SurfaceMesh copy = surface;
   copy.garbage_collection();
   return std::make_shared<const ReferenceSurface>(copy);
+}
+
+CaseSetup setup_case(const CaseConfig& config) {
+  CaseSetup setup;
+  SurfaceMesh& mesh = setup.mesh;
+  mesh = make_case_surface(config);
+  mesh.garbage_collection();
+  EvolutionOptions& options = setup.options;
+  options.remesh = config.remesh;
+  options.remesh.reference = make_case_reference(config, mesh);
+  if (config.region.kind == RegionSpec::Kind::Refs) {
+    label_from_refs(config, mesh);
+    remesh(mesh, options.remesh);
+  } else {
+    mesh_initial_region(mesh, initial_level_set(config, mesh), config.discretize, options.remesh);
+  }
+  setup.h = config.remesh.hmax > 0 ? config.remesh.hmax : mean_edge_length(mesh);
+  options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * setup.h;
+  options.final_time = config.time.final_time;
+  options.max_iterations = config.time.iterations;
+  options.distance = config.distance;
+  options.advection = config.advection;
+  options.discretize = config.discretize;
+  options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
+  return setup;
 }
 
 void label_from_refs(const CaseConfig& config, SurfaceMesh& surface) {

@@ -4,7 +4,7 @@
 //   [surface]    file = "s.mesh"  |  generator = "sphere" (faces|h, radius) | "terrain" (extent, h,
 //                seed, dem, max_height, feature_size) | "plane" (size, h)
 //   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
-//                degrees, center) | "disks" (centers = [[x, y], ...], radii = [...])
+//                degrees, center; or axes = [[..], ..] and angles = [..] for a union of caps) | "disks" (centers = [[x, y], ...], radii = [...])
 //   [model]      name = "conormal", every other key is the model's own parameter
 //   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations
 //   [distance] [advection] [discretize] [remesh]   options of each stage
@@ -14,6 +14,7 @@
 // 'tiem' in [time]; did you mean 'time'?"), as is a wrong type or a missing required key.
 #include <bodyfit/advection.hpp>
 #include <bodyfit/distance.hpp>
+#include <bodyfit/evolution.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/mesh.hpp>
@@ -48,6 +49,8 @@ struct RegionSpec {
   std::filesystem::path sol;        ///< Kind::Sol: φ at the vertices of the surface (< 0 inside)
   Vec3 axis{0, 0, 1};               ///< Kind::Cap: unit axis of the cap
   double angle = 45;                ///< Kind::Cap: polar angle, degrees
+  /// Kind::Cap with `axes` and `angles` (a union of caps): (unit axis, angle in degrees) each.
+  std::vector<std::pair<Vec3, double>> caps;
   Vec3 center{0, 0, 0};             ///< Kind::Cap: centre of the sphere
   std::vector<std::array<double, 3>> disks;  ///< Kind::Disks: (x, y, radius), horizontal distance
 };
@@ -103,6 +106,15 @@ ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surfa
 /// The fixed reference surface S for the remesher: the exact sphere for a generated sphere, else
 /// the triangles of `surface` (call before any remeshing).
 std::shared_ptr<const ReferenceSurface> make_case_reference(const CaseConfig& config, const SurfaceMesh& surface);
+/// Everything a run needs before its first iteration.
+struct CaseSetup {
+  SurfaceMesh mesh;          ///< T^0: S with G(0) meshed (garbage-collected)
+  EvolutionOptions options;  ///< dt, end, stage options, remesh reference (no callbacks)
+  double h = 0;              ///< the mesh size of Δt = cfl·h
+};
+/// Build S, its reference, T^0 (cut + remesh, or refs + remesh) and the evolution options.
+CaseSetup setup_case(const CaseConfig& config);
+
 /// Label `surface`'s faces from its refs (RegionSpec::Kind::Refs): refs listed are G.
 void label_from_refs(const CaseConfig& config, SurfaceMesh& surface);
 

@@ -1,0 +1,242 @@
+// The TOML case: validation messages (unknown keys with suggestions, missing keys, wrong types),
+// --set overrides, and the analytic initial regions.
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/geometry.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+using namespace bodyfit;
+
+namespace {
+
+const char* kValidCase = R"(
+[surface]
+generator = "sphere"
+faces = 320
+
+[region]
+shape = "cap"
+axis = [0, 0, 1]
+angle = 45
+
+[model]
+name = "conormal"
+speed = 2.0
+
+[time]
+cfl = 0.5
+final_time = 0.78
+
+[remesh]
+hmax = 0.2
+)";
+
+CaseConfig parse(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  toml::table table = toml::parse(text);
+  for (const auto& o : overrides) apply_override(table, o);
+  return parse_case(table);
+}
+
+std::string error_of(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    parse(text, overrides);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+bool contains(const std::string& haystack, const std::string& needle) {
+  return haystack.find(needle) != std::string::npos;
+}
+
+}  // namespace
+
+TEST_CASE("a valid case is read into its options") {
+  CaseConfig c = parse(kValidCase);
+  CHECK(c.surface.kind == SurfaceSpec::Kind::Sphere);
+  CHECK(c.surface.sphere.faces == 320);
+  CHECK(c.region.kind == RegionSpec::Kind::Cap);
+  CHECK(c.region.angle == 45);
+  CHECK(c.model == "conormal");
+  CHECK(c.model_parameters["speed"].value<double>() == 2.0);
+  CHECK(!c.model_parameters.contains("name"));
+  CHECK(c.time.cfl == 0.5);
+  CHECK(c.time.dt == 0);
+  CHECK(c.time.final_time == 0.78);
+  CHECK(c.time.iterations == -1);
+  CHECK(c.remesh.hmax == 0.2);
+  CHECK(c.output.vtu_every == 1);
+}
+
+TEST_CASE("unknown keys and tables are errors with a suggestion") {
+  std::string text = kValidCase;
+  text.replace(text.find("final_time"), 10, "final_tiem");
+  std::string e = error_of(text);
+  CHECK_MESSAGE(contains(e, "unknown key 'final_tiem' in [time]"), e);
+  CHECK_MESSAGE(contains(e, "did you mean 'final_time'?"), e);
+
+  e = error_of(std::string(kValidCase) + "\n[remesh_options]\nhmin = 1\n");
+  CHECK_MESSAGE(contains(e, "unknown table [remesh_options]"), e);
+  CHECK_MESSAGE(contains(e, "did you mean 'remesh'?"), e);
+
+  e = error_of(kValidCase, {"remesh.hgard=1.5"});
+  CHECK_MESSAGE(contains(e, "unknown key 'hgard' in [remesh]; did you mean 'hgrad'?"), e);
+
+  // Nothing close: no suggestion.
+  e = error_of(kValidCase, {"output.zzzzzzzzzz=1"});
+  CHECK_MESSAGE(contains(e, "unknown key 'zzzzzzzzzz' in [output]"), e);
+  CHECK_MESSAGE(!contains(e, "did you mean"), e);
+
+  // A bad choice suggests the closest valid value.
+  e = error_of(kValidCase, {"region.shape=cpa"});
+  CHECK_MESSAGE(contains(e, "did you mean 'cap'"), e);
+}
+
+TEST_CASE("missing required keys are named") {
+  std::string text = kValidCase;
+  text.replace(text.find("name = \"conormal\""), 17, "");
+  std::string e = error_of(text);
+  CHECK_MESSAGE(contains(e, "[model] missing key 'name'"), e);
+
+  text = kValidCase;
+  text.replace(text.find("cfl = 0.5"), 9, "");
+  e = error_of(text);
+  CHECK_MESSAGE(contains(e, "[time] give exactly one of 'dt' and 'cfl'"), e);
+
+  text = kValidCase;
+  text.replace(text.find("final_time = 0.78"), 17, "");
+  e = error_of(text);
+  CHECK_MESSAGE(contains(e, "'final_time' or 'iterations'"), e);
+
+  text = kValidCase;
+  text.replace(text.find("angle = 45"), 10, "");
+  e = error_of(text);
+  CHECK_MESSAGE(contains(e, "missing key 'angle'"), e);
+
+  e = error_of("[model]\nname = \"x\"\n");
+  CHECK_MESSAGE(contains(e, "missing table [surface]"), e);
+}
+
+TEST_CASE("wrong types and values are errors naming the key") {
+  std::string e = error_of(kValidCase, {"time.final_time=\"soon\""});
+  CHECK_MESSAGE(contains(e, "[time] final_time: expected a number"), e);
+  e = error_of(kValidCase, {"output.vtu_every=1.5"});
+  CHECK_MESSAGE(contains(e, "[output] vtu_every: expected an integer"), e);
+  e = error_of(kValidCase, {"remesh.hmax=-1"});
+  CHECK_MESSAGE(contains(e, "[remesh] hmax: must be > 0"), e);
+  e = error_of(kValidCase, {"region.axis=[1, 2]"});
+  CHECK_MESSAGE(contains(e, "[region] axis: expected 3 numbers, got 2"), e);
+  e = error_of(kValidCase, {"surface.extent=5"});
+  CHECK_MESSAGE(contains(e, "extent: does not apply to generator 'sphere'"), e);
+  e = error_of(kValidCase, {"time.dt=0.1"});
+  CHECK_MESSAGE(contains(e, "exactly one of 'dt' and 'cfl'"), e);
+}
+
+TEST_CASE("--set overrides any key with a dotted path, typed as TOML") {
+  CaseConfig c = parse(kValidCase, {"time.cfl=0.25", "model.speed=3", "output.view=top", "time.iterations=7",
+                                    "output.size=[320, 200]", "distance.narrow_band=0.5"});
+  CHECK(c.time.cfl == 0.25);
+  CHECK(c.model_parameters["speed"].value<double>() == 3.0);
+  CHECK(c.output.view == "top");  // a bare word is a string
+  CHECK(c.time.iterations == 7);
+  CHECK(c.output.width == 320);
+  CHECK(c.output.height == 200);
+  CHECK(c.distance.narrow_band == 0.5);  // a table absent from the file is created
+  // The effective table carries the overrides (it becomes outdir/case.toml).
+  CHECK(c.effective["time"]["cfl"].value<double>() == 0.25);
+  CHECK(contains(error_of(kValidCase, {"time.cfl"}), "expected key=value"));
+  CHECK(contains(error_of(kValidCase, {"model.name.x=1"}), "'name' is not a table"));
+}
+
+TEST_CASE("every example case of meshes/cases is valid") {
+  for (const char* name : {"sphere_cap", "plane_disk", "plane_boundary", "two_caps_merge"}) {
+    CAPTURE(name);
+    CaseConfig c = read_case(test::source_path(std::string("meshes/cases/") + name + ".toml"));
+    CHECK(c.model == "conormal");
+  }
+  // An error in a file names the file.
+  test::TempDir dir("case-config");
+  {
+    std::ofstream out(dir / "bad.toml");
+    out << kValidCase << "\n[time]\n";  // duplicate table: a TOML syntax error
+  }
+  try {
+    read_case(dir / "bad.toml");
+    FAIL("expected an error");
+  } catch (const InputError& e) {
+    CHECK(contains(e.what(), "bad.toml:"));
+  }
+}
+
+TEST_CASE("the plane generator covers the square with good triangles") {
+  CaseConfig c = parse(R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.1
+[region]
+shape = "disks"
+centers = [[0.0, 0.0], [0.5, 0.5]]
+radii = [0.3, 0.1]
+[model]
+name = "conormal"
+[time]
+dt = 0.1
+iterations = 1
+)");
+  SurfaceMesh plane = make_case_surface(c);
+  CHECK(total_area(plane) == doctest::Approx(4.0).epsilon(1e-12));
+  CHECK(quality_stats(plane).min > 0.8);
+  CHECK(boundary_loops(plane).size() == 1);
+  CHECK(euler_characteristic(plane) == 1);
+  CHECK(edge_length_stats(plane).mean == doctest::Approx(0.1).epsilon(0.1));
+  // Disks: horizontal distance to the nearest circle.
+  ScalarField phi = initial_level_set(c, plane);
+  for (auto v : plane.vertices()) {
+    const Vec3& p = plane.point(v);
+    double expected = std::min(std::hypot(p[0], p[1]) - 0.3, std::hypot(p[0] - 0.5, p[1] - 0.5) - 0.1);
+    CHECK(phi[v.idx()] == doctest::Approx(expected).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("a cap's level set is the exact geodesic distance on the sphere") {
+  CaseConfig c = parse(kValidCase, {"surface.radius=2.0", "region.angle=30"});
+  SurfaceMesh sphere = make_case_surface(c);
+  ScalarField phi = initial_level_set(c, sphere);
+  for (auto v : sphere.vertices()) {
+    const Vec3& p = sphere.point(v);
+    double beta = std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0));
+    CHECK(phi[v.idx()] == doctest::Approx(2.0 * (beta - std::numbers::pi / 6)).epsilon(1e-9));
+  }
+  // A union of caps: the min of the two distances.
+  CaseConfig two = parse(R"(
+[surface]
+generator = "sphere"
+faces = 320
+[region]
+shape = "cap"
+axes = [[0, 0, 1], [0, 0, -1]]
+angles = [30, 60]
+[model]
+name = "conormal"
+[time]
+dt = 0.1
+iterations = 1
+)");
+  phi = initial_level_set(two, sphere);
+  for (auto v : sphere.vertices()) {
+    const Vec3& p = sphere.point(v);
+    double beta = std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0));
+    double expected = std::min(beta - std::numbers::pi / 6, (std::numbers::pi - beta) - std::numbers::pi / 3);
+    CHECK(phi[v.idx()] == doctest::Approx(expected).epsilon(1e-9));
+  }
+}
