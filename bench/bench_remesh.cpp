@@ -3,7 +3,7 @@
 //   bench_remesh [--quick] [csv]   (default csv: bench_remesh.csv)
 //
 // Sphere: geodesic unit sphere, φ = β − π/4 (β = acos z), hmax = mean input edge; the remesher
-// projects onto the exact sphere. Terrain: height field over [0,50]² (km) with a 1 km disk, the
+// projects onto the exact sphere. Terrain: make_terrain over [0,50]² (in km) with a 1 km disk, the
 // remesher projects onto the input triangles. Then one evolution step: the cap grows by about one
 // element (β − (π/4 + h)), discretize + remesh of the already-remeshed mesh; its cost is compared
 // with the full first remeshing.
@@ -100,33 +100,13 @@ Row run_case(const std::string& name, SurfaceMesh& mesh, const ScalarField& phi,
 
 double mean_edge(const SurfaceMesh& mesh) { return edge_length_stats(mesh).mean; }
 
-/// A smooth height field over [0, 50]² (km), about `faces` triangles in a regular grid whose
-/// cells are split along alternating diagonals.
-SurfaceMesh make_height_field(std::size_t faces) {
-  int n = int(std::sqrt(double(faces) / 2.0));
-  double step = 50.0 / n;
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> vh;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      double x = i * step, y = j * step;
-      double z = 0.6 * std::sin(x / 6.0) * std::cos(y / 8.0) + 0.3 * std::sin((x + y) / 11.0);
-      vh.push_back(mesh.add_vertex(Vec3(x, y, z)));
-    }
-  auto id = [&](int i, int j) { return vh[std::size_t(j) * (n + 1) + i]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      auto a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
-      if ((i + j) % 2 == 0) {
-        mesh.add_face(a, b, c);
-        mesh.add_face(a, c, d);
-      } else {
-        mesh.add_face(a, b, d);
-        mesh.add_face(b, c, d);
-      }
-      mesh.region(FaceHandle(int(mesh.n_faces()) - 1)) = kOutside;
-      mesh.region(FaceHandle(int(mesh.n_faces()) - 2)) = kOutside;
-    }
+/// The procedural terrain of generators.hpp over [0, 50 km]² with about `faces` triangles, in km.
+SurfaceMesh make_km_terrain(std::size_t faces) {
+  TerrainOptions t;
+  t.h = std::sqrt(t.extent * t.extent / double(faces) * 4 / std::sqrt(3.0));
+  auto mesh = make_terrain(t);
+  for (auto v : mesh.vertices()) mesh.set_point(v, mesh.point(v) * 1e-3);
+  for (auto f : mesh.faces()) mesh.region(f) = kOutside;
   return mesh;
 }
 
@@ -170,7 +150,7 @@ int main(int argc, char** argv) {
 
   {
     std::size_t faces = quick ? 20000 : 240000;
-    auto mesh = make_height_field(faces);
+    auto mesh = make_km_terrain(faces);
     auto reference = std::make_shared<const ReferenceSurface>(mesh);
     RemeshOptions options;
     options.hmax = mean_edge(mesh);

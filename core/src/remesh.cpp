@@ -6,7 +6,10 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/projection.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -31,6 +34,8 @@ constexpr double kCollapseRatio = 0.71;
 constexpr double kGoodQuality = 0.6;
 // A collapse may create triangles down to this quality (never below the worst one it removes).
 constexpr double kAcceptQuality = 0.4;
+// Curve vertices are relocated only when one of their triangles is below this quality.
+constexpr double kCurveRepairQuality = 0.6;
 // Flips are tried only when the worse triangle of the pair is below this quality.
 constexpr double kFlipBelow = 0.75;
 // Relocation spreads at most this many rings away from a topological change or a bad element.
@@ -67,7 +72,11 @@ class Remesher {
     m_.add_property(ecurve_);
     m_.add_property(estamp_);
   }
-  ~Remesher() {
+  ~Remesher() { release(); }
+  /// Drop the working properties (before garbage collection, which then has less to compact).
+  void release() {
+    if (released_) return;
+    released_ = true;
     m_.remove_property(size_);
     m_.remove_property(kind_);
     m_.remove_property(vcurve_);
@@ -126,6 +135,7 @@ class Remesher {
   OpenMesh::EPropHandleT<char> ecurve_;
   OpenMesh::EPropHandleT<int> estamp_;
   int stamp_ = 0;
+  bool released_ = false;
   std::vector<VertexHandle> work_, next_;
 };
 
@@ -140,30 +150,33 @@ void Remesher::setup_sizes() {
 }
 
 void Remesher::classify_features() {
-  // Ridges by dihedral angle, added to the ridges read from the file.
-  if (opt_.feature_angle > 0) {
-    double cos_limit = std::cos(opt_.feature_angle * M_PI / 180.0);
-    for (auto e : m_.edges()) {
-      if (m_.is_boundary(e)) continue;
-      auto t0 = triangle(face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[0],
-                         face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[1],
-                         face_points(m_, m_.face_handle(m_.halfedge_handle(e, 0)))[2]);
-      auto p1 = face_points(m_, m_.face_handle(m_.halfedge_handle(e, 1)));
-      auto t1 = triangle(p1[0], p1[1], p1[2]);
+  // Per-face normal and quality, once (every sweep below is parallel and writes only its own element).
+  const int nf = int(m_.n_faces()), ne = int(m_.n_edges()), nv = int(m_.n_vertices());
+  std::vector<Tri> face_tri(nf);
+  tbb::parallel_for(0, nf, [&](int i) {
+    auto p = face_points(m_, FaceHandle(i));
+    face_tri[i] = triangle(p[0], p[1], p[2]);
+  });
+  // Ridges by dihedral angle, added to the ridges read from the file; then the curve kind of edges.
+  const bool detect = opt_.feature_angle > 0;
+  const double cos_limit = std::cos(opt_.feature_angle * M_PI / 180.0);
+  tbb::parallel_for(0, ne, [&](int i) {
+    EdgeHandle e(i);
+    if (detect && !m_.is_boundary(e)) {
+      const auto& t0 = face_tri[m_.face_handle(m_.halfedge_handle(e, 0)).idx()];
+      const auto& t1 = face_tri[m_.face_handle(m_.halfedge_handle(e, 1)).idx()];
       // Slivers (e.g. fresh from discretize) have unreliable normals: no ridge from them.
-      if (t0.quality < 1e-3 || t1.quality < 1e-3) continue;
-      if ((t0.normal | t1.normal) < cos_limit) m_.ridge(e) = 1;
+      if (t0.quality >= 1e-3 && t1.quality >= 1e-3 && (t0.normal | t1.normal) < cos_limit) m_.ridge(e) = 1;
     }
-  }
-  for (auto e : m_.edges()) {
     char c = kNoCurve;
     if (m_.required(e)) c = kRequiredCurve;
     else if (m_.interface(e)) c = kInterfaceCurve;
     else if (m_.ridge(e)) c = kRidgeCurve;
     else if (m_.is_boundary(e)) c = kBoundaryCurve;
     m_.property(ecurve_, e) = c;
-  }
-  for (auto v : m_.vertices()) {
+  });
+  tbb::parallel_for(0, nv, [&](int i) {
+    VertexHandle v(i);
     int count = 0;
     char type = kNoCurve;
     bool mixed = false, locked = m_.required(v) || m_.corner(v);
@@ -188,12 +201,23 @@ void Remesher::classify_features() {
     if (mixed) locked = true;
     m_.property(kind_, v) = locked ? kLockedVertex : (count == 2 ? kCurveVertex : kFreeVertex);
     m_.property(vcurve_, v) = count == 2 ? type : kNoCurve;
-    m_.property(vnormal_, v) = ref_->analytic() ? ref_->closest(m_.point(v)).normal : vertex_normal(m_, v);
+    Vec3 normal(0, 0, 0);
     int hint = -1;
-    if (!opt_.reference)
-      for (auto f : m_.vf_range(v)) hint = f.idx();
+    if (ref_->analytic()) {
+      normal = ref_->closest(m_.point(v)).normal;
+    } else {
+      // Area-weighted face normals (the quality-weighted cross products are proportional to areas).
+      for (auto f : m_.vf_range(v)) {
+        auto p = face_points(m_, f);
+        normal += (p[1] - p[0]) % (p[2] - p[0]);
+        if (!opt_.reference) hint = f.idx();
+      }
+      double len = normal.norm();
+      if (len > 0) normal /= len;
+    }
+    m_.property(vnormal_, v) = normal;
     m_.property(hint_, v) = hint;
-  }
+  });
   // Cut points lie on chords of S: put the interface on S before it becomes the reference curve
   // (a no-op when S is the input mesh itself).
   if (opt_.reference)
@@ -222,8 +246,9 @@ void Remesher::compute_sizing() {
   };
   double kappa_sphere = 0;
   if (ref_->analytic()) kappa_sphere = 1.0 / ref_->sphere_radius();
-  bool uniform = true;
-  for (auto v : m_.vertices()) {
+  std::atomic<bool> uniform = true;
+  tbb::parallel_for(0, int(m_.n_vertices()), [&](int i) {
+    VertexHandle v(i);
     double kappa = kappa_sphere;
     char kind = m_.property(kind_, v);
     if (!ref_->analytic() && kind == kFreeVertex) {
@@ -270,7 +295,7 @@ void Remesher::compute_sizing() {
     double h = size_for(kappa);
     m_.property(size_, v) = h;
     if (h < hmax_) uniform = false;
-  }
+  });
   if (uniform) return;
   // Gradation: h(w) ≤ h(v) + ln(hgrad)·|vw|, propagated from the small sizes outwards.
   double slope = std::log(std::max(opt_.hgrad, 1.0 + 1e-6));
@@ -564,6 +589,9 @@ double Remesher::relocate(VertexHandle v) {
     old_sum += old_tri.quality;
     new_sum += t.quality;
   }
+  // Curve vertices move only to repair a poor triangle: a point between the reference curve's
+  // vertices lies on a chord, off the true curve by up to h²κ/8.
+  if (kind == kCurveVertex && old_min >= kCurveRepairQuality) return 0;
   bool better = new_min >= old_min || (new_min >= 0.6 && new_sum > old_sum);
   if (!better) return 0;
   m_.set_point(v, q);
@@ -660,7 +688,9 @@ RemeshReport Remesher::run() {
   for (auto v : work_) m_.property(in_work_, v) = 0;
   for (auto v : next_) m_.property(in_next_, v) = 0;
 
-  m_.garbage_collection();
+  stamp("passes");
+  release();
+  if (report_.collapses > 0) m_.garbage_collection();
   stamp("gc");
   auto q = quality_stats(m_);
   report_.min_quality = q.min;
@@ -672,7 +702,11 @@ RemeshReport Remesher::run() {
 }  // namespace
 
 RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions& options) {
-  mesh.garbage_collection();
+  bool garbage = false;
+  for (auto v : mesh.all_vertices()) garbage |= mesh.status(v).deleted();
+  for (auto e : mesh.all_edges()) garbage |= mesh.status(e).deleted();
+  for (auto f : mesh.all_faces()) garbage |= mesh.status(f).deleted();
+  if (garbage) mesh.garbage_collection();
   Remesher remesher(mesh, options);
   return remesher.run();
 }
