@@ -3,10 +3,12 @@
 // many random level sets.
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/validate.hpp>
 
 #include <doctest/doctest.h>
+#include <test_support.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -480,4 +482,36 @@ TEST_CASE("random level sets never produce an invalid mesh") {
     }
     CHECK(separated > 0);  // saddles at zero vertices occurred and were handled
   }
+}
+
+TEST_CASE("bodyfit discretize: cut (and remesh) from Medit files") {
+  test::TempDir dir("discretize_cli");
+  SurfaceMesh sphere = make_sphere({.faces = 1280});
+  write_mesh(sphere, dir / "sphere.mesh");
+  write_scalar_sol(dir / "phi.sol", sample(sphere, [](const Vec3& p) { return polar_angle(p) - 1.0; }));
+
+  auto cut = test::run_bodyfit("discretize " + (dir / "sphere.mesh").string() + " --phi " + (dir / "phi.sol").string() +
+                               " --no-remesh -o " + (dir / "cut.mesh").string());
+  INFO(cut.output);
+  REQUIRE(cut.exit_code == 0);
+  SurfaceMesh mesh = read_mesh(dir / "cut.mesh");
+  require_valid(mesh, strict(2, 0));
+  CHECK(mesh.n_faces() > sphere.n_faces());
+  CHECK(interface_curves(mesh).closed == 1);
+
+  auto remeshed = test::run_bodyfit("discretize " + (dir / "sphere.mesh").string() + " --phi " +
+                                    (dir / "phi.sol").string() + " -o " + (dir / "out.mesh").string());
+  INFO(remeshed.output);
+  REQUIRE(remeshed.exit_code == 0);
+  SurfaceMesh out = read_mesh(dir / "out.mesh");
+  ValidateOptions options;
+  options.euler_characteristic = 2;
+  options.boundary_loops = 0;
+  require_valid(out, options);
+  CHECK(interface_curves(out).closed == 1);
+
+  auto wrong = test::run_bodyfit("discretize " + (dir / "sphere.mesh").string() + " --phi " +
+                                 (dir / "sphere.mesh").string() + " -o " + (dir / "bad.mesh").string());
+  CHECK(wrong.exit_code != 0);
+  CHECK(!std::filesystem::exists(dir / "bad.mesh"));
 }

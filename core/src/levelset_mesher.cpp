@@ -59,13 +59,13 @@ struct QuadCut {
 
 /// Snap the vertices whose crossing lies within snap_ratio of them (in index order, so the result
 /// does not depend on anything but the input), keeping every φ = 0 vertex a simple interface point.
-void snap(const SurfaceMesh& mesh, ScalarField& value, double snap_ratio, DiscretizeReport& report) {
+void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, ScalarField& value, double snap_ratio,
+          DiscretizeReport& report) {
   if (snap_ratio <= 0) return;
   std::vector<int> candidates;
-  for (auto e : mesh.edges()) {
+  for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
     int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-    if (!opposite_signs(value[a], value[b])) continue;
     double t = zero_fraction(value[a], value[b]);
     if (t < snap_ratio) candidates.push_back(a);
     if (1 - t < snap_ratio) candidates.push_back(b);
@@ -108,8 +108,8 @@ void snap(const SurfaceMesh& mesh, ScalarField& value, double snap_ratio, Discre
 /// geometric mean of |φ| over its negative neighbours, so the new crossings sit at comparable
 /// fractions of their edges. This may spoil a zero neighbour in turn: repeat until none is left
 /// (each vertex moves at most once, since only vertices with φ = 0 can be spoiled).
-void separate_pinches(const SurfaceMesh& mesh, ScalarField& value, DiscretizeReport& report) {
-  std::vector<VertexHandle> work;
+std::vector<VertexHandle> separate_pinches(const SurfaceMesh& mesh, ScalarField& value, DiscretizeReport& report) {
+  std::vector<VertexHandle> work, separated;
   for (auto v : mesh.vertices())
     if (value[v.idx()] == 0 && !acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v)))
       work.push_back(v);
@@ -128,10 +128,17 @@ void separate_pinches(const SurfaceMesh& mesh, ScalarField& value, DiscretizeRep
     if (largest == 0) continue;  // cannot happen: an interface vertex has a negative neighbour
     value[v.idx()] = std::sqrt(smallest * largest);
     ++report.separated_vertices;
+    separated.push_back(v);
     for (auto w : mesh.vv_range(v))
       if (value[w.idx()] == 0 && !acceptable_degree(mesh, w, predicted_interface_degree(mesh, value, w)))
         work.push_back(w);
   }
+  return separated;
+}
+
+bool crossed_edge(const SurfaceMesh& mesh, const ScalarField& value, EdgeHandle e) {
+  auto h = mesh.halfedge_handle(e, 0);
+  return opposite_signs(value[mesh.from_vertex_handle(h).idx()], value[mesh.to_vertex_handle(h).idx()]);
 }
 
 void set_edge_tags(SurfaceMesh& mesh, EdgeHandle e, const EdgeTags& tags) {
@@ -173,16 +180,22 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     if (!std::isfinite(value[v.idx()]))
       throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
 
-  snap(mesh, value, options.snap_ratio, report);
-  separate_pinches(mesh, value, report);
-
-  // Crossed edges and the faces cut into a triangle and a quad, found on the unsplit mesh.
+  // Crossed edges: the input's, less those a snap removed, plus those around separated vertices.
   std::vector<EdgeHandle> crossed;
-  for (auto e : mesh.edges()) {
-    auto h = mesh.halfedge_handle(e, 0);
-    if (opposite_signs(value[mesh.from_vertex_handle(h).idx()], value[mesh.to_vertex_handle(h).idx()]))
-      crossed.push_back(e);
+  for (auto e : mesh.edges())
+    if (crossed_edge(mesh, value, e)) crossed.push_back(e);
+  snap(mesh, crossed, value, options.snap_ratio, report);
+  auto separated = separate_pinches(mesh, value, report);
+  std::erase_if(crossed, [&](EdgeHandle e) { return !crossed_edge(mesh, value, e); });
+  if (!separated.empty()) {
+    for (auto v : separated)
+      for (auto e : mesh.ve_range(v))
+        if (crossed_edge(mesh, value, e)) crossed.push_back(e);
+    std::sort(crossed.begin(), crossed.end());
+    crossed.erase(std::unique(crossed.begin(), crossed.end()), crossed.end());
   }
+
+  // Faces cut into a triangle and a quad, found on the unsplit mesh.
   std::vector<QuadCut> quads;
   for (auto e : crossed)
     for (int side = 0; side < 2; ++side) {
@@ -204,7 +217,12 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   report.crossed_edges = crossed.size();
 
   // Split every crossed edge at the zero of the linear interpolant.
-  std::vector<VertexHandle> crossing(mesh.n_edges());
+  // The i-th crossed edge (in index order) gets the vertex first_crossing + i.
+  const int first_crossing = int(mesh.n_vertices());
+  auto crossing = [&](int edge_index) {
+    auto it = std::lower_bound(crossed.begin(), crossed.end(), EdgeHandle(edge_index));
+    return VertexHandle(first_crossing + int(it - crossed.begin()));
+  };
   value.reserve(value.size() + crossed.size());
   for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
@@ -217,7 +235,6 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     mesh.corner(p) = 0;
     mesh.required(p) = 0;
     value.push_back(0);
-    crossing[e.idx()] = p;
     mesh.split(e, p);
     // OpenMesh leaves the properties of the new edges undefined: the halves of e keep its tags,
     // the edges to the opposite vertices start untagged.
@@ -229,29 +246,41 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   report.inserted_vertices = crossed.size();
 
   for (const auto& quad : quads)
-    if (improve_diagonal(mesh, crossing[quad.edge_ab], quad.b, quad.c, crossing[quad.edge_ca]))
+    if (improve_diagonal(mesh, crossing(quad.edge_ab), quad.b, quad.c, crossing(quad.edge_ca)))
       ++report.flipped_diagonals;
 
   // Every face now lies on one side: inside when a vertex is negative.
   for (auto f : mesh.faces()) {
-    bool inside = false;
-    for (auto v : mesh.fv_range(f)) inside |= value[v.idx()] < 0;
+    auto h = mesh.halfedge_handle(f);
+    auto h1 = mesh.next_halfedge_handle(h);
+    bool inside = value[mesh.to_vertex_handle(h).idx()] < 0 || value[mesh.to_vertex_handle(h1).idx()] < 0 ||
+                  value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
     report.inside_faces += inside;
   }
   for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
-  update_interface_from_regions(mesh);
 
-  std::vector<int> degree;
+  // The interface: exactly the edges between faces of different labels (as
+  // update_interface_from_regions), counting interface edges per vertex as a self-check.
+  std::vector<VertexHandle> interface_vertices;
+  std::vector<unsigned char> degree;
   for (auto e : mesh.edges()) {
-    if (!mesh.interface(e)) continue;
-    ++report.interface_edges;
-    if (degree.empty()) degree.assign(mesh.n_vertices(), 0);
-    for (int side = 0; side < 2; ++side) ++degree[mesh.to_vertex_handle(mesh.halfedge_handle(e, side)).idx()];
+    auto h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
+    auto f0 = mesh.face_handle(h0), f1 = mesh.face_handle(h1);
+    bool is_interface = f0.is_valid() && f1.is_valid() && mesh.region(f0) != mesh.region(f1);
+    mesh.interface(e) = is_interface;
+    if (is_interface) {
+      mesh.edge_ref(e) = kInterfaceRef;
+      ++report.interface_edges;
+      if (degree.empty()) degree.assign(mesh.n_vertices(), 0);
+      for (auto v : {mesh.to_vertex_handle(h0), mesh.to_vertex_handle(h1)})
+        if (degree[v.idx()]++ == 0) interface_vertices.push_back(v);
+    } else if (mesh.edge_ref(e) == kInterfaceRef) {
+      mesh.edge_ref(e) = 0;
+    }
   }
-  if (!degree.empty())
-    for (auto v : mesh.vertices())
-      if (!acceptable_degree(mesh, v, degree[v.idx()])) ++report.pinched_vertices;
+  for (auto v : interface_vertices)
+    if (!acceptable_degree(mesh, v, degree[v.idx()])) ++report.pinched_vertices;
 
   bool has_deleted = false;
   for (std::size_t i = 0; i < mesh.n_faces() && !has_deleted; ++i) has_deleted = mesh.status(FaceHandle(int(i))).deleted();
