@@ -293,8 +293,8 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m) {
   return s;
 }
 
-constexpr int kNearRings = 4;
-constexpr double kNearRadius = 3;
+constexpr int kNearRings = 3;
+constexpr double kNearRadius = 2.5;
 
 using HeapEntry = std::pair<double, int>;
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<>>;
