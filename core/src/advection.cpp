@@ -17,11 +17,14 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <utility>
 #include <limits>
 #include <string>
 
@@ -93,7 +96,43 @@ struct Surface {
   std::vector<std::array<int, 3>> corners;  ///< vertex indices of each face
   std::vector<int> vertex_face;          ///< one face incident to each vertex
   std::vector<signed char> vertex_slot;  ///< the vertex's corner slot in that face
+  std::vector<int> vertex_order;         ///< vertices in Z-order: neighbours trace through the same faces
 };
+
+/// Spreads the low 21 bits of x to every third bit (Morton interleaving).
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Indices 0..n−1 sorted by the Z-order (Morton) code of point(i) in the box, ties by index, so the
+/// order is deterministic. Walks from neighbouring vertices then touch neighbouring memory.
+template <class PointOf>
+std::vector<int> z_order(int n, const BoundingBox& box, PointOf point_of) {
+  const Vec3 extent = box.max - box.min;
+  const double scale = double((1 << 21) - 1);
+  std::vector<std::pair<std::uint64_t, int>> keyed(n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 8192), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i != range.end(); ++i) {
+      const Vec3 p = point_of(i);
+      std::uint64_t code = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double t = extent[c] > 0 ? (p[c] - box.min[c]) / extent[c] : 0.0;
+        code |= spread_bits(std::uint64_t(std::clamp(t, 0.0, 1.0) * scale)) << c;
+      }
+      keyed[i] = {code, i};
+    }
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
+}
 
 Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
   Surface s;
@@ -103,11 +142,21 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
   s.corners.resize(nf);
   s.vertex_face.assign(nv, -1);
   s.vertex_slot.assign(nv, 0);
+  // Faces are stored in Z-order of their centroids: a walk's next face is usually close in memory.
+  const BoundingBox box = bounding_box(mesh);
+  const std::vector<int> face_order = z_order(nf, box, [&](int fi) {
+    Vec3 c(0, 0, 0);
+    for (auto v : mesh.fv_range(FaceHandle(fi))) c += mesh.point(v);
+    return c / 3.0;
+  });
+  std::vector<int> slot_of(nf);
+  for (int i = 0; i < nf; ++i) slot_of[face_order[i]] = i;
+  s.vertex_order = z_order(nv, box, [&](int vi) { return mesh.point(VertexHandle(vi)); });
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& range) {
     for (int fi = range.begin(); fi != range.end(); ++fi) {
       const FaceHandle fh(fi);
-      Face& f = s.faces[fi];
-      std::array<int, 3>& corner = s.corners[fi];
+      Face& f = s.faces[slot_of[fi]];
+      std::array<int, 3>& corner = s.corners[slot_of[fi]];
       V3 p[3];
       // Corner i is the target of halfedge h_i; the edge opposite corner i is that of h_{i+1}.
       HalfedgeHandle h[3];
@@ -141,7 +190,7 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
         f.across[i] = 0;
         if (mesh.is_boundary(opposite)) continue;
         const FaceHandle gh = mesh.face_handle(opposite);
-        f.neighbour[i] = gh.idx();
+        f.neighbour[i] = slot_of[gh.idx()];
         // Slots in g: the corner opposite the shared edge is next(opposite)'s target.
         HalfedgeHandle gh0 = mesh.halfedge_handle(gh);
         HalfedgeHandle gh_[3] = {gh0, mesh.next_halfedge_handle(gh0), HalfedgeHandle()};
@@ -349,7 +398,8 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
   std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, nv, 256), [&](const tbb::blocked_range<int>& range) {
     std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0;
-    for (int v = range.begin(); v != range.end(); ++v) {
+    for (int k = range.begin(); k != range.end(); ++k) {
+      const int v = s.vertex_order[k];
       const int fi = s.vertex_face[v];
       if (fi < 0) {  // isolated vertex: nothing carries it
         out[v] = phi[v];
