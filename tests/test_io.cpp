@@ -288,6 +288,33 @@ TEST_CASE("round trip .mesh and .meshb: bit-exact points, same faces, refs and t
   CHECK(files_in(dir.path()) == 4);
 }
 
+TEST_CASE("writers skip deleted elements and renumber the vertices") {
+  TempDir dir("io-deleted");
+  auto mesh = tagged_sphere(320);
+  mesh.delete_vertex(VertexHandle(5));  // removes its faces too, leaving a hole
+  std::size_t live_vertices = 0, live_faces = 0;
+  for (auto v : mesh.vertices()) (void)v, ++live_vertices;
+  for (auto f : mesh.faces()) (void)f, ++live_faces;
+  for (const char* name : {"d.mesh", "d.meshb", "d.off"}) {
+    CAPTURE(name);
+    write_mesh(mesh, dir / name);
+    auto back = read_mesh(dir / name);
+    REQUIRE(back.n_vertices() == live_vertices);
+    REQUIRE(back.n_faces() == live_faces);
+    const double tolerance = std::string(name) == "d.off" ? 1e-7 : 0.0;
+    // The k-th live vertex (face) becomes vertex (face) k, in the same order.
+    int k = 0;
+    for (auto v : mesh.vertices()) CHECK((mesh.point(v) - back.point(VertexHandle(k++))).norm() <= tolerance);
+    k = 0;
+    for (auto f : mesh.faces()) {
+      std::vector<Vec3> a, b;
+      for (auto v : mesh.fv_range(f)) a.push_back(mesh.point(v));
+      for (auto v : back.fv_range(FaceHandle(k++))) b.push_back(back.point(v));
+      for (int i = 0; i < 3; ++i) CHECK((a[i] - b[i]).norm() <= tolerance);
+    }
+  }
+}
+
 TEST_CASE("Edges section: interface edges with ref 10, ridges, required, refs and boundary edges") {
   TempDir dir("io-edges");
   // An open square of two triangles: four boundary edges, one inner interface edge.
@@ -597,6 +624,13 @@ TEST_CASE("bad input in .mesh text: each error names the file, the line and what
                      "Triangles\n2\n1 2 3 0\n1 4 5 0\nEnd\n");
   CHECK(contains(m, "nm-vertex.mesh:5:"));
   CHECK(contains(m, "vertex 1 is non-manifold"));
+
+  // Two closed tetrahedra sharing vertex 1: OpenMesh refuses the first face of the second one.
+  m = read_error(dir, "pinch.mesh",
+                 h + "Vertices\n7\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n-1 0 0 0\n0 -1 0 0\n0 0 -1 0\n" +
+                     "Triangles\n8\n1 3 2 0\n1 2 4 0\n2 3 4 0\n1 4 3 0\n1 6 5 0\n1 5 7 0\n5 6 7 0\n1 7 6 0\nEnd\n");
+  CHECK(contains(m, "pinch.mesh:18:"));
+  CHECK(contains(m, "triangle 5: non-manifold vertex"));
 
   m = read_error(dir, "flat.mesh",
                  h + "Vertices\n4\n0 0 0 0\n1 0 0 0\n2 0 0 0\n0 1 0 0\nTriangles\n2\n1 2 4 0\n1 2 3 0\nEnd\n");

@@ -91,8 +91,15 @@ void write_openmesh_format(const SurfaceMesh& mesh, const std::filesystem::path&
   SurfaceMesh compacted;
   if (mesh.n_vertices() != std::size_t(std::distance(mesh.vertices().begin(), mesh.vertices().end())) ||
       mesh.n_faces() != std::size_t(std::distance(mesh.faces().begin(), mesh.faces().end()))) {
-    compacted = mesh;
-    compacted.garbage_collection();
+    // Rebuild in order (garbage_collection would move the last elements into the holes), so
+    // every format numbers vertices and faces the same way.
+    const auto index = vertex_numbering(mesh);
+    for (auto v : mesh.vertices()) compacted.add_vertex(mesh.point(v));
+    for (auto f : mesh.faces()) {
+      std::vector<VertexHandle> corners;
+      for (auto v : mesh.fv_range(f)) corners.push_back(VertexHandle(int(index[std::size_t(v.idx())])));
+      compacted.add_face(corners);
+    }
     source = &compacted;
   }
   write_atomically(file, [&](std::ostream& out) {
