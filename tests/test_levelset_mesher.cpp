@@ -1,6 +1,7 @@
 // discretize(): marching triangles of the zero level set, checked against exact crossing points,
 // exact areas (second-order convergence), topology of the interface, and the validity checker on
 // many random level sets.
+#include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
@@ -514,4 +515,19 @@ TEST_CASE("bodyfit discretize: cut (and remesh) from Medit files") {
                                  (dir / "sphere.mesh").string() + " -o " + (dir / "bad.mesh").string());
   CHECK(wrong.exit_code != 0);
   CHECK(!std::filesystem::exists(dir / "bad.mesh"));
+}
+
+TEST_CASE("bad level sets are input errors; deleted elements are collected") {
+  SurfaceMesh mesh = make_sphere({.faces = 320});
+  CHECK_THROWS_AS(discretize(mesh, ScalarField(mesh.n_vertices() - 1, 1.0)), InputError);
+  ScalarField phi = sample(mesh, [](const Vec3& p) { return p[2]; });
+  phi[5] = std::nan("");
+  CHECK_THROWS_AS(discretize(mesh, phi), InputError);
+
+  // A face deleted (leaving a hole) before the cut: the result is garbage-collected and valid.
+  mesh.delete_face(*mesh.faces().begin(), false);
+  auto report = discretize(mesh, sample(mesh, [](const Vec3& p) { return p[2] - 0.2; }));
+  CHECK(report.inserted_vertices > 0);
+  require_valid(mesh, strict(1, 1));
+  CHECK(mesh.n_faces() >= 319 + report.split_faces);  // each cut face becomes 2 or 3
 }
