@@ -42,4 +42,34 @@ cmake --install "$work/plugin-build" --prefix "$work/prefix" > "$work/install-pl
 listing=$(env -u BODYFIT_PLUGIN_PATH "$work/prefix/bin/bodyfit" plugins 2>&1) || { echo "$listing"; fail "bodyfit plugins"; }
 grep -A1 "^windy " <<< "$listing" | grep -qF "$work/prefix/" || { echo "$listing"; fail "installed windy not found"; }
 
+step "a 2-iteration run with it"
+cat > "$work/case.toml" <<'TOML'
+[surface]
+generator = "sphere"
+h = 0.15
+
+[region]
+shape = "cap"
+axis = [0.0, 0.0, 1.0]
+angle = 45.0
+
+[model]
+name = "windy"
+base = 0.5
+wind = [0.3, 0.0, 0.0]
+smoothing = 0.1
+
+[time]
+dt = 0.02
+iterations = 2
+TOML
+BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" run "$work/case.toml" -o "$work/run" \
+  > "$work/run.log" 2>&1 || { cat "$work/run.log"; fail "bodyfit run with the windy model"; }
+grep -qF "plugin-build/bodyfit_windy.so" "$work/run.log" || { cat "$work/run.log"; fail "the run did not use the built plugin"; }
+history="$work/run/history.csv"
+[[ -f "$history" ]] || fail "no history.csv"
+head -n1 "$history" | grep -q "max_speed" || { cat "$history"; fail "the model's metric is not in history.csv"; }
+[[ $(wc -l < "$history") -eq 4 ]] || { cat "$history"; fail "history.csv should have a header and rows for iterations 0, 1, 2"; }
+grep -q "windy_speed" "$work/run/step_00001.vtu" || fail "the model's point field is not in the VTU"
+
 echo "out-of-tree plugin: OK"
