@@ -8,8 +8,12 @@
 // walk continues there. A path that reaches a vertex or runs along an edge is handled by the same
 // rule (a zero-length step crosses to the next face), so no characteristic is ever dropped.
 //
-// Tangent vectors computed in one face (the velocity at an intermediate Runge–Kutta stage) are
-// carried back to the start face by the inverse of the accumulated unfolding rotations.
+// Tangent vectors are moved between faces by the composed unfolding rotations: RK4 carries each
+// stage's velocity back to the start face (the transpose), RK2 carries V(x) forward to the midpoint
+// and continues walking from there.
+//
+// Faces are stored, and vertices traced, in Z-order so that neighbouring characteristics read
+// neighbouring memory; each trace is independent, so the result does not depend on the threads.
 #include <bodyfit/advection.hpp>
 
 #include <bodyfit/error.hpp>
@@ -24,9 +28,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <utility>
-#include <limits>
 #include <string>
+#include <utility>
 
 namespace bodyfit {
 namespace {
