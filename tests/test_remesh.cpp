@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <bodyfit/generators.hpp>
+#include <bodyfit/io.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/projection.hpp>
@@ -12,6 +13,8 @@
 #include <cmath>
 #include <map>
 #include <random>
+
+#include "test_support.hpp"
 
 using namespace bodyfit;
 
@@ -313,4 +316,21 @@ TEST_CASE("discretize + remesh of random level sets never produces an invalid me
     INFO("trial " << trial);
     CHECK(problems(mesh, vo) == "");
   }
+}
+
+TEST_CASE("bodyfit remesh: reads a Medit mesh, writes a valid remeshed one, rejects a missing file") {
+  test::TempDir dir("remesh_cli");
+  auto mesh = make_sphere({.faces = 2000});
+  discretize(mesh, cap_phi(mesh, 1.0));
+  write_mesh(mesh, dir / "cut.mesh");
+  auto run = test::run_bodyfit("remesh " + (dir / "cut.mesh").string() + " -o " + (dir / "out.mesh").string() + " --hmax 0.15");
+  INFO(run.output);
+  REQUIRE(run.exit_code == 0);
+  auto out = read_mesh(dir / "out.mesh");
+  ValidateOptions vo;
+  vo.euler_characteristic = 2;
+  CHECK(problems(out, vo) == "");
+  CHECK(out.has_regions());
+  CHECK(interface_curves(out).closed == 1);
+  CHECK(test::run_bodyfit("remesh " + (dir / "missing.mesh").string() + " -o " + (dir / "x.mesh").string()).exit_code != 0);
 }
