@@ -9,7 +9,7 @@ PACKAGES=(
   libfmt-dev libspdlog-dev doctest-dev libtomlplusplus-dev libcli11-dev libtbb-dev
   libpng-dev libgdal-dev
   gdal-bin  # gdal_translate: the GeoTIFF test converts an .asc to .tif with it
-  python3-vtk9  # tests/test_io.cpp reads the VTU back with VTK (skipped when absent)
+  python3-vtk9 python3-meshio  # tests/test_io.cpp cross-checks VTU and Medit files (skipped when absent)
 )
 
 missing=()

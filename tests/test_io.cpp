@@ -513,6 +513,54 @@ TEST_CASE("VTU opens in VTK (python3-vtk9, the reader ParaView uses)") {
   CHECK(z3 == mesh.point(VertexHandle(3))[2]);
 }
 
+TEST_CASE("meshio (an independent Medit/VTU implementation) reads our files and writes files we read") {
+  if (std::system("/usr/bin/python3 -c 'import meshio' > /dev/null 2>&1") != 0) {
+    MESSAGE("python3-meshio not installed: skipped (scripts/setup.sh installs it)");
+    return;
+  }
+  TempDir dir("io-meshio");
+  // Regions and interface edges only: meshio 5 does not know Ridges/RequiredEdges/Corners.
+  auto mesh = make_sphere({.faces = 500});
+  for (auto v : mesh.vertices()) mesh.phi(v) = mesh.point(v)[2] - 0.1;
+  label_regions_from_phi(mesh);
+  for (const char* name : {"s.mesh", "s.meshb", "s.vtu"}) write_mesh(mesh, dir / name);
+  write_text(dir / "check.py",
+             "import sys, warnings\n"
+             "warnings.simplefilter('ignore')\n"
+             "import meshio, numpy as np\n"
+             "d = sys.argv[1]\n"
+             "ms = [meshio.read(d + '/s.' + e) for e in ('mesh', 'meshb', 'vtu')]\n"
+             "tri = [m.get_cells_type('triangle') for m in ms]\n"
+             "same = all(np.array_equal(ms[0].points, m.points) for m in ms) and "
+             "all(np.array_equal(tri[0], t) for t in tri)\n"
+             "print(len(ms[0].points), len(tri[0]), int(same), '%.17g' % ms[1].points[7][2])\n"
+             "pts = np.array([[1,0,0],[-1,0,0],[0,1,0],[0,-1,0],[0,0,1],[0,0,-1.0]])\n"
+             "t = np.array([[1,3,5],[3,2,5],[2,4,5],[4,1,5],[3,1,6],[2,3,6],[4,2,6],[1,4,6]]) - 1\n"
+             "o = meshio.Mesh(pts, [('triangle', t)], cell_data={'medit:ref': [np.array([3,3,3,3,2,2,2,2])]},\n"
+             "                point_data={'medit:ref': np.array([0,4,0,0,0,0])})\n"
+             "o.write(d + '/o.meshb')\n"
+             "o.write(d + '/o.mesh')\n");
+  const auto out = dir / "out.txt";
+  const std::string command = "/usr/bin/python3 " + (dir / "check.py").string() + " " + dir.path().string() + " > " +
+                              out.string() + " 2>&1";
+  const int status = std::system(command.c_str());
+  INFO(read_text(out));
+  REQUIRE(status == 0);
+  std::istringstream result(read_text(out));
+  std::size_t points = 0, triangles = 0;
+  int same = 0;
+  double z7 = 0;
+  result >> points >> triangles >> same >> z7;
+  CHECK(points == mesh.n_vertices());
+  CHECK(triangles == mesh.n_faces());
+  CHECK(same == 1);
+  CHECK(z7 == mesh.point(VertexHandle(7))[2]);
+  for (const char* name : {"o.meshb", "o.mesh"}) {
+    CAPTURE(name);
+    check_fixture_octahedron(read_mesh(dir / name), false);
+  }
+}
+
 TEST_CASE("PVD: valid after each add, resume keeps the entries up to max_time") {
   TempDir dir("io-pvd");
   const auto file = dir / "series.pvd";
