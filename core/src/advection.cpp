@@ -81,15 +81,16 @@ inline void compose_unfolding(M3& r, V3 e, V3 a1, V3 n1, V3 a2, V3 n2) {
 // its corners), so the record holds what the walk and the velocity evaluation read, and nothing
 // else: three cache lines. The vertex indices, read once per characteristic, are kept apart.
 struct alignas(64) Face {
-  V3 grad[3];        ///< gradients of the P1 basis functions (in the face's plane)
-  V3 velocity[3];    ///< V at the corners, projected on the face's plane (V is P1: project, then interpolate)
-  V3 normal;         ///< unit normal
-  int neighbour[3];  ///< face across the edge opposite corner i, −1 on the boundary
+  // What the walk reads comes first (the first 140 bytes), the corner velocities last.
+  V3 grad[3];          ///< gradients of the P1 basis functions (in the face's plane)
+  V3 normal;           ///< unit normal
+  double altitude[3];  ///< 1/|∇λ_i|: the unfolding needs unit directions, without a square root
+  int neighbour[3];    ///< face across the edge opposite corner i, −1 on the boundary
   /// In the neighbour across edge i: bits 0–1 the slot of the corner opposite that edge, bits 2–3
   /// the slot of this face's corner (i + 1) % 3 (the third slot holds corner (i + 2) % 3).
   unsigned char across[3];
   float size;        ///< mean edge length: sets the sub-step
-  double altitude[3];  ///< 1/|∇λ_i|: the unfolding needs unit directions, without a square root
+  V3 velocity[3];    ///< V at the corners, projected on the face's plane (V is P1: project, then interpolate)
 };
 static_assert(sizeof(Face) == 256);  // 211 bytes of data
 
