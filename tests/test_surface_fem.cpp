@@ -100,6 +100,34 @@ TEST_CASE("Rayleigh quotient of the degree-1 harmonic on the sphere is about its
   CHECK(quotient == doctest::Approx(2.0).epsilon(5e-3));
 }
 
+TEST_CASE("smallest non-zero generalized eigenvalue of (K, M) on the unit sphere is about 2") {
+  // Inverse iteration through the smoother with l = 1: u = (M + K)^{-1} M f multiplies an
+  // eigenvector of eigenvalue λ by 1/(1 + λ). Removing the constants (λ = 0) M-orthogonally at each
+  // step leaves the smallest non-zero eigenvalue (λ1 = 2, the degree-1 harmonics, continuous value).
+  SurfaceMesh sphere = make_sphere({.faces = 5120});
+  auto m = mass_matrix(sphere);
+  H1Smoother smoother(m, stiffness_matrix(sphere), 1.0);
+  Eigen::VectorXd ones = Eigen::VectorXd::Ones(m.rows());
+  const double mass_of_ones = ones.dot(m * ones);
+  auto remove_constants = [&](ScalarField& f) {
+    Eigen::Map<Eigen::VectorXd> fv(f.data(), Eigen::Index(f.size()));
+    fv -= (ones.dot(m * fv) / mass_of_ones) * ones;
+    fv /= std::sqrt(fv.dot(m * fv));
+  };
+  ScalarField f = field(sphere, [](const Vec3& p) { return std::sin(3 * p[0]) + p[1] * p[2] + 0.3 * p[2]; });
+  remove_constants(f);
+  double lambda = 0;
+  for (int iteration = 0; iteration < 40; ++iteration) {
+    ScalarField u = smoother.smooth(f);
+    Eigen::Map<const Eigen::VectorXd> fv(f.data(), Eigen::Index(f.size())), uv(u.data(), Eigen::Index(u.size()));
+    double shrink = fv.dot(m * uv);  // f is M-normalised: the Rayleigh quotient of (M + K)^{-1} M
+    lambda = 1.0 / shrink - 1.0;
+    f = u;
+    remove_constants(f);
+  }
+  CHECK(lambda == doctest::Approx(2.0).epsilon(3e-3));  // measured 2.0029
+}
+
 TEST_CASE("H1 smoothing: l = 0 is the identity, constants are kept, harmonics are damped by 1/(1+l²λ)") {
   SurfaceMesh sphere = make_sphere({.faces = 20480});
   ScalarField f = field(sphere, harmonic8);
@@ -125,7 +153,7 @@ TEST_CASE("H1 smoothing: l = 0 is the identity, constants are kept, harmonics ar
     // u is (nearly) a multiple of g: project to get the factor, then check the residual is small.
     double factor = dot(u, g) / dot(g, g);
     CAPTURE(degree);
-    CHECK(factor == doctest::Approx(expected).epsilon(0.03));
+    CHECK(factor == doctest::Approx(expected).epsilon(0.01));
     ScalarField residual(u.size());
     for (std::size_t i = 0; i < u.size(); ++i) residual[i] = u[i] - factor * g[i];
     CHECK(mass_norm2(residual) < 1e-3 * mass_norm2(u));
@@ -183,8 +211,8 @@ TEST_CASE("StepContext conormal on a sphere cap points along e_theta within O(h)
   double fine = conormal_error(20480, &h_fine);
   CAPTURE(coarse);
   CAPTURE(fine);
-  CHECK(coarse < h_coarse);
-  CHECK(fine < h_fine);
+  CHECK(coarse < 0.3 * h_coarse);
+  CHECK(fine < 0.3 * h_fine);
   CHECK(fine < 0.5 * coarse);  // h is divided by 4: at least first order
 }
 
