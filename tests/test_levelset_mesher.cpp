@@ -531,3 +531,33 @@ TEST_CASE("bad level sets are input errors; deleted elements are collected") {
   require_valid(mesh, strict(1, 1));
   CHECK(mesh.n_faces() >= 319 + report.split_faces);  // each cut face becomes 2 or 3
 }
+
+TEST_CASE("the quad of a two-crossing cut gets the diagonal whose worse triangle is better") {
+  for (auto [phi_b, phi_c] : {std::pair{1.0, 3.0}, std::pair{3.0, 1.0}, std::pair{1.0, 9.0}, std::pair{9.0, 1.0},
+                              std::pair{0.5, 2.0}, std::pair{2.0, 0.5}}) {
+    CAPTURE(phi_b);
+    CAPTURE(phi_c);
+    SurfaceMesh mesh;
+    Vec3 A(0, 0, 0), B(1, 0, 0), C(0, 1, 0);
+    auto a = mesh.add_vertex(A);  // separate statements: argument evaluation order is unspecified
+    auto b = mesh.add_vertex(B);
+    auto c = mesh.add_vertex(C);
+    mesh.add_face(a, b, c);
+    discretize(mesh, {-1.0, phi_b, phi_c}, {.snap_ratio = 0});
+    require_valid(mesh, strict(1, 1));
+    REQUIRE(mesh.n_faces() == 3);
+    Vec3 P = A + (1 / (1 + phi_b)) * (B - A), Q = A + (1 / (1 + phi_c)) * (C - A);
+    double with_pc = std::min(triangle_quality(P, B, C), triangle_quality(P, C, Q));
+    double with_bq = std::min(triangle_quality(P, B, Q), triangle_quality(B, C, Q));
+    REQUIRE(with_pc != with_bq);
+    double worst = 1;
+    for (auto f : mesh.faces()) worst = std::min(worst, face_quality(mesh, f));
+    // The corner triangle (A, P, Q) is fixed; the quad's two triangles are the better pair.
+    CHECK(worst == doctest::Approx(std::min(triangle_quality(A, P, Q), std::max(with_pc, with_bq))).epsilon(1e-12));
+    int quad_triangles_at_best = 0;
+    for (auto f : mesh.faces())
+      if (!mesh.inside(f)) quad_triangles_at_best += face_quality(mesh, f) >= std::max(with_pc, with_bq) * (1 - 1e-12);
+    CHECK(quad_triangles_at_best == 2);
+    CHECK(interface_length(mesh) == doctest::Approx((P - Q).norm()).epsilon(1e-14));
+  }
+}

@@ -153,15 +153,11 @@ bool improve_diagonal(SurfaceMesh& mesh, VertexHandle p, VertexHandle b, VertexH
   const Vec3 &P = mesh.point(p), &B = mesh.point(b), &C = mesh.point(c), &Q = mesh.point(q);
   double with_pc = std::min(triangle_quality(P, B, C), triangle_quality(P, C, Q));
   double with_bq = std::min(triangle_quality(P, B, Q), triangle_quality(B, C, Q));
-  HalfedgeHandle current = mesh.find_halfedge(p, c);
-  bool want_bq = with_bq > with_pc;
-  if (!current.is_valid()) {
-    current = mesh.find_halfedge(b, q);
-    want_bq = !(with_pc > with_bq);
-    if (!current.is_valid() || want_bq) return false;
-  } else if (!want_bq) {
-    return false;
-  }
+  // The diagonal to remove, if it is the one present; a tie keeps what the splits made.
+  HalfedgeHandle current = with_bq > with_pc ? mesh.find_halfedge(p, c)
+                           : with_pc > with_bq ? mesh.find_halfedge(b, q)
+                                               : HalfedgeHandle();
+  if (!current.is_valid()) return false;
   auto e = mesh.edge_handle(current);
   if (!mesh.is_flip_ok(e)) return false;
   mesh.flip(e);
