@@ -358,7 +358,6 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
   auto index_list = [&](const char* section, std::vector<std::int64_t>& items, Locator& at) {
     auto n = count_of(section);
     items.reserve(items.size() + std::size_t(n));
-    at = Locator::lines();
     for (std::int64_t i = 0; i < n; ++i) {
       in.set_context(section, i, n);
       in.skip_blank();
