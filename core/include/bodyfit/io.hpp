@@ -25,9 +25,13 @@ struct ReadOptions {
   double min_relative_area = 1e-14;
 };
 
-/// Read any supported mesh format, chosen by extension.
+/// Read any supported mesh format (.mesh .meshb .obj .off .ply .stl), chosen by extension.
+/// Medit refs and tags map onto the mesh properties (see docs/formats.md); e:interface is set on
+/// edges listed with ref 10 and on edges between a face of region 3 and a face of another region.
 SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {});
-/// Write any supported mesh format, chosen by extension (.mesh/.meshb keep refs and tags).
+/// Write any supported mesh format (.mesh .meshb .obj .off .ply .stl .vtu), chosen by extension.
+/// .mesh/.meshb keep refs and tags: Edges lists interface (ref 10), ridge, required, non-zero-ref
+/// and boundary edges. Deleted elements are skipped and the vertices renumbered in order.
 void write_mesh(const SurfaceMesh& mesh, const std::filesystem::path& file);
 
 /// A field at the vertices: `dimension` components per vertex, stored vertex-major.
