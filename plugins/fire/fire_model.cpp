@@ -161,7 +161,15 @@ class FireModel final : public VelocityModel {
         sum += speed[v.idx()];
         ++count;
       }
-    field.metrics = {{"ros_min", count ? lo : 0.0}, {"ros_mean", count ? sum / double(count) : 0.0}, {"ros_max", hi}};
+    // Over the whole landscape too (R is defined everywhere through the extended n_Σ): the speed
+    // field a figure of S coloured by R shows, a statistic that does not depend on where the front is.
+    double all_sum = 0, all_max = 0;
+    for (double r : speed) all_sum += r, all_max = std::max(all_max, r);
+    field.metrics = {{"ros_min", count ? lo : 0.0},
+                     {"ros_mean", count ? sum / double(count) : 0.0},
+                     {"ros_max", hi},
+                     {"ros_all_mean", speed.empty() ? 0.0 : all_sum / double(speed.size())},
+                     {"ros_all_max", all_max}};
     field.point_fields.emplace_back("rate_of_spread", speed);
     if (arrival_.initialised()) field.point_fields.emplace_back("arrival_time", arrival_.sample_at_vertices(mesh));
     return field;

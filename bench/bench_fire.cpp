@@ -1,0 +1,176 @@
+// Time per iteration of the wildfire model (paper §4.3) at the paper's mesh size, and the
+// area/perimeter plot of finished runs.
+//
+//   bench_fire [--case meshes/cases/fire_one_disk.toml] [--h 150] [--iterations 8] [-o outdir]
+//     Runs the case's first iterations with the terrain and hmax at edge length h (h = 150 m gives
+//     ≈ 240,000 triangles on the 50 km landscape, the paper's size), prints the per-stage times of
+//     every iteration (wall and process CPU time: the machine may be shared) and writes
+//     outdir/fire_timing.csv.
+//
+//   bench_fire --plot outdir run_dir [run_dir...]
+//     Reads each run's history.csv (from `bodyfit run`) and writes outdir/fire_area.png and
+//     outdir/fire_perimeter.png: burnt area (km²) and front length (km) against time (min).
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/evolution.hpp>
+#include <bodyfit/plot.hpp>
+#include <bodyfit/plugin_loader.hpp>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace bodyfit;
+
+namespace {
+
+double cpu_seconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
+
+// Columns of a CSV file with a header row, by name.
+std::map<std::string, std::vector<double>> read_columns(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error("cannot read " + file.string());
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  std::stringstream header(line);
+  for (std::string name; std::getline(header, name, ',');) names.push_back(name);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    std::size_t k = 0;
+    for (std::string cell; std::getline(row, cell, ',') && k < names.size(); ++k)
+      columns[names[k]].push_back(cell.empty() ? std::nan("") : std::stod(cell));
+  }
+  return columns;
+}
+
+int plot_runs(const std::filesystem::path& outdir, const std::vector<std::filesystem::path>& runs) {
+  std::filesystem::create_directories(outdir);
+  std::vector<PlotSeries> area, perimeter;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    auto columns = read_columns(runs[i] / "history.csv");
+    PlotSeries a;
+    a.label = runs[i].filename().string();  // "run_fire_one_disk" -> "one disk"
+    for (const std::string prefix : {"run_", "fire_"})
+      if (a.label.rfind(prefix, 0) == 0) a.label.erase(0, prefix.size());
+    std::replace(a.label.begin(), a.label.end(), '_', ' ');
+    a.color = series_color(i);
+    a.markers = false;
+    PlotSeries p = a;
+    for (std::size_t k = 0; k < columns["time"].size(); ++k) {
+      const double minutes = columns["time"][k] / 60;
+      a.x.push_back(minutes), a.y.push_back(columns["area"][k] / 1e6);
+      p.x.push_back(minutes), p.y.push_back(columns["interface_length"][k] / 1e3);
+    }
+    area.push_back(a), perimeter.push_back(p);
+  }
+  PlotOptions options;
+  options.width = 640, options.height = 440;
+  options.x_label = "time (min)";
+  options.title = "Burnt area";
+  options.y_label = "area (km2)";
+  plot_png(outdir / "fire_area.png", area, options);
+  options.title = "Front length (perimeter)";
+  options.y_label = "perimeter (km)";
+  plot_png(outdir / "fire_perimeter.png", perimeter, options);
+  fmt::print("wrote {0}/fire_area.png and {0}/fire_perimeter.png\n", outdir.string());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path case_file = "meshes/cases/fire_one_disk.toml";
+  double h = 150;
+  int iterations = 8;
+  std::filesystem::path outdir = "bench_fire_out";
+  if (argc >= 3 && !std::strcmp(argv[1], "--plot")) {
+    std::vector<std::filesystem::path> runs(argv + 3, argv + argc);
+    return plot_runs(argv[2], runs);
+  }
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc) throw std::runtime_error(fmt::format("{} needs a value", argv[i]));
+      return argv[++i];
+    };
+    if (!std::strcmp(argv[i], "--case")) case_file = next();
+    else if (!std::strcmp(argv[i], "--h")) h = std::stod(next());
+    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::stoi(next());
+    else if (!std::strcmp(argv[i], "-o")) outdir = next();
+    else {
+      fmt::print(stderr,
+                 "usage: bench_fire [--case file.toml] [--h 150] [--iterations 8] [-o outdir]\n"
+                 "       bench_fire --plot outdir run_dir [run_dir...]\n");
+      return 2;
+    }
+  }
+  std::filesystem::create_directories(outdir);
+  spdlog::set_level(spdlog::level::warn);
+
+  CaseConfig config = read_case(case_file, {fmt::format("surface.h={}", h), fmt::format("remesh.hmax={}", h)});
+  LoadedModel model = load_model(config.model);
+  configure_model(model, config.model_parameters);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double cpu0 = cpu_seconds();
+  CaseSetup setup = setup_case(config);
+  const double setup_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  const double setup_cpu = cpu_seconds() - cpu0;
+  fmt::print("{}: h = {} m, T^0 has {} triangles (setup {:.2f} s wall, {:.2f} s CPU)\n", case_file.string(), h,
+             setup.mesh.n_faces(), setup_wall, setup_cpu);
+
+  setup.options.log = false;
+  setup.options.max_iterations = iterations;
+  std::ofstream csv(outdir / "fire_timing.csv");
+  csv << "iteration,faces,ms_velocity,ms_distance,ms_advect,ms_discretize,ms_remesh,ms_output,ms_total,"
+         "ms_wall,ms_cpu,ros_min,ros_mean,ros_max\n";
+  fmt::print("{:>4} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}  (ms: vel dist adv disc remesh, total, CPU)\n",
+             "n", "faces", "vel", "dist", "adv", "disc", "remesh", "total", "cpu");
+  auto last_wall = std::chrono::steady_clock::now();
+  double last_cpu = cpu_seconds();
+  StageTimes sum;
+  double cpu_sum = 0;
+  int count = 0;
+  setup.options.on_iteration = [&](const SurfaceMesh& mesh, const IterationRecord& r) {
+    const auto now = std::chrono::steady_clock::now();
+    const double wall_ms = 1000 * std::chrono::duration<double>(now - last_wall).count();
+    const double cpu_ms = 1000 * (cpu_seconds() - last_cpu);
+    last_wall = now, last_cpu = cpu_seconds();
+    auto metric = [&](const char* name) {
+      for (const auto& [key, value] : r.metrics)
+        if (key == name) return value;
+      return std::nan("");
+    };
+    fmt::print("{:>4} {:>8} {:>8.0f} {:>8.0f} {:>8.0f} {:>8.0f} {:>8.0f} {:>9.0f} {:>9.0f}\n", r.iteration,
+               mesh.n_faces(), r.ms.velocity, r.ms.distance, r.ms.advect, r.ms.discretize, r.ms.remesh, r.ms.total(),
+               cpu_ms);
+    csv << fmt::format("{},{},{:.1f},{:.1f},{:.1f},{:.1f},{:.1f},{:.1f},{:.1f},{:.1f},{:.1f},{:.5g},{:.5g},{:.5g}\n",
+                       r.iteration, mesh.n_faces(), r.ms.velocity, r.ms.distance, r.ms.advect, r.ms.discretize,
+                       r.ms.remesh, r.ms.output, r.ms.total(), wall_ms, cpu_ms, metric("ros_min"), metric("ros_mean"),
+                       metric("ros_max"));
+    sum.velocity += r.ms.velocity, sum.distance += r.ms.distance, sum.advect += r.ms.advect;
+    sum.discretize += r.ms.discretize, sum.remesh += r.ms.remesh, sum.output += r.ms.output;
+    cpu_sum += cpu_ms;
+    ++count;
+    std::fflush(stdout);
+  };
+  evolve(setup.mesh, model.model(), setup.options);
+  if (count > 0) {
+    const double n = count;
+    fmt::print("mean per iteration over {} iterations: {:.0f} ms (vel {:.0f}, dist {:.0f}, adv {:.0f}, disc {:.0f}, "
+               "remesh {:.0f}); process CPU {:.0f} ms\n",
+               count, sum.total() / n, sum.velocity / n, sum.distance / n, sum.advect / n, sum.discretize / n,
+               sum.remesh / n, cpu_sum / n);
+  }
+  fmt::print("wrote {}\n", (outdir / "fire_timing.csv").string());
+  return 0;
+}
