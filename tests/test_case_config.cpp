@@ -84,8 +84,8 @@ TEST_CASE("unknown keys and tables are errors with a suggestion") {
   CHECK_MESSAGE(contains(e, "unknown key 'final_tiem' in [time]"), e);
   CHECK_MESSAGE(contains(e, "did you mean 'final_time'?"), e);
 
-  e = error_of(std::string(kValidCase) + "\n[remesh_options]\nhmin = 1\n");
-  CHECK_MESSAGE(contains(e, "unknown table [remesh_options]"), e);
+  e = error_of(std::string(kValidCase) + "\n[remsh]\nhmin = 1\n");
+  CHECK_MESSAGE(contains(e, "unknown table [remsh]"), e);
   CHECK_MESSAGE(contains(e, "did you mean 'remesh'?"), e);
 
   e = error_of(kValidCase, {"remesh.hgard=1.5"});
@@ -195,7 +195,9 @@ iterations = 1
 )");
   SurfaceMesh plane = make_case_surface(c);
   CHECK(total_area(plane) == doctest::Approx(4.0).epsilon(1e-12));
-  CHECK(quality_stats(plane).min > 0.8);
+  // Near-equilateral rows; the half cells at the row ends are the worst triangles.
+  CHECK(quality_stats(plane).min > 0.5);
+  CHECK(quality_stats(plane).mean > 0.9);
   CHECK(boundary_loops(plane).size() == 1);
   CHECK(euler_characteristic(plane) == 1);
   CHECK(edge_length_stats(plane).mean == doctest::Approx(0.1).epsilon(0.1));
@@ -236,7 +238,8 @@ iterations = 1
   for (auto v : sphere.vertices()) {
     const Vec3& p = sphere.point(v);
     double beta = std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0));
-    double expected = std::min(beta - std::numbers::pi / 6, (std::numbers::pi - beta) - std::numbers::pi / 3);
+    // (the sphere has radius 2)
+    double expected = 2.0 * std::min(beta - std::numbers::pi / 6, (std::numbers::pi - beta) - std::numbers::pi / 3);
     CHECK(phi[v.idx()] == doctest::Approx(expected).epsilon(1e-9));
   }
 }

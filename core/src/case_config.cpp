@@ -372,12 +372,12 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     auto& out = config.time;
     out.dt = s.positive("dt", 0);
     out.cfl = s.positive("cfl", 0);
-    if ((out.dt > 0) == (out.cfl > 0)) s.fail("give exactly one of 'dt' and 'cfl'");
     out.final_time = s.positive("final_time", out.final_time);
     out.iterations = s.integer("iterations", -1);
+    s.check_unknown();  // first: a misspelt key often explains a missing one
+    if ((out.dt > 0) == (out.cfl > 0)) s.fail("give exactly one of 'dt' and 'cfl'");
     if (s.has("iterations") && out.iterations < 0) s.fail("iterations: must be ≥ 0");
     if (!s.has("final_time") && !s.has("iterations")) s.fail("give 'final_time' or 'iterations' (or both)");
-    s.check_unknown();
   }
   {  // [distance]
     Section s = section("distance");
