@@ -263,7 +263,15 @@ Image render(const SurfaceMesh& mesh, const RenderOptions& options) {
   const Vec3 center = (box.min + box.max) * 0.5;
   const double radius = std::max(box.diagonal() / 2, 1e-300);
   const double distance = 3 * radius;
-  const double scale = 0.92 * std::min(plot_width, options.height) / (2 * radius);
+  // Fit the projected extent of the mesh (around the box centre) to the picture.
+  double extent_u = 0, extent_v = 0;
+  for (auto vh : mesh.vertices()) {
+    Vec3 q = mesh.point(vh) - center;
+    extent_u = std::max(extent_u, std::abs(dot(q, u))), extent_v = std::max(extent_v, std::abs(dot(q, v)));
+  }
+  double scale = 0.92 * std::min(plot_width, options.height) / (2 * radius);
+  if (!options.perspective && extent_u > 0 && extent_v > 0)
+    scale = 0.92 * std::min(plot_width / (2 * extent_u), options.height / (2 * extent_v));
   struct Projected {
     double x, y, depth;  // depth: larger is closer
   };
