@@ -11,6 +11,8 @@
 
 #include "test_support.hpp"
 
+#include <fmt/format.h>
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -182,4 +184,30 @@ TEST_CASE("a run on a DEM read from an ESRI ASCII grid writes arrival times") {
   CHECK(near > 0);
   CHECK(near < run.result.time);
   CHECK(fire::raster_nearest(arrival, 1000, 1000) == arrival.nodata);
+}
+
+TEST_CASE("a fuel map's non-burnable cells stop the front") {
+  test::TempDir dir("fire_fuel");
+  // Fuel codes on 100 m cells over [0, 1200]²: 1 (burnable) for x < 700, 0 (not burnable) beyond.
+  {
+    std::ofstream out(dir / "fuel.asc");
+    out << "ncols 12\nnrows 12\nxllcorner 0\nyllcorner 0\ncellsize 100\nNODATA_value -9999\n";
+    for (int r = 0; r < 12; ++r)
+      for (int c = 0; c < 12; ++c) out << (c < 7 ? 1 : 0) << (c < 11 ? " " : "\n");
+  }
+  const double R0 = fire::BalbiParameters{}.R0, h = 20, dt = 20, r0 = 150;
+  const int steps = 30;  // 600 s: unobstructed, the front would reach x = 650 + 600·R0 ≈ 889 m
+  FireRun run = burn(inclined_plane(1200, h, 0), {{500, 600, r0}},
+                     fmt::format("[fuel]\nmap = \"{}\"\npresets = [\"balbi2009\"]\n", (dir / "fuel.asc").string()), dt,
+                     steps, {}, 0.05);
+  REQUIRE(run.result.records.size() == std::size_t(steps));
+  double x_min = 1e30, x_max = -1e30;
+  for (auto f : run.mesh.faces())
+    if (run.mesh.region(f) == kInside)
+      for (auto v : run.mesh.fv_range(f)) x_min = std::min(x_min, run.mesh.point(v)[0]), x_max = std::max(x_max, run.mesh.point(v)[0]);
+  const double free_run = R0 * run.result.time;  // distance a front travels on open ground
+  INFO("x_min " << x_min << " x_max " << x_max << " free run " << free_run);
+  CHECK(650 + free_run > 800);                     // the barrier is really in the way
+  CHECK(x_max <= 700 + 2 * h);                     // stopped within one cell of P1 interpolation of the speed
+  CHECK(std::abs((500 - r0 - x_min) - free_run) / free_run < 0.02);  // the other side burns at R0
 }
