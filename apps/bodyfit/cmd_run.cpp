@@ -102,6 +102,9 @@ std::vector<double> png_field(const CaseConfig& config, const StateView& s) {
 }
 
 int run_case(const RunArguments& args) {
+  // From the start (a Ctrl-C during setup stops before the first iteration), and even when the
+  // shell started us with SIGINT ignored (background jobs).
+  std::signal(SIGINT, on_sigint);
   CaseConfig config = read_case(args.case_file, args.sets);
   const fs::path outdir =
       args.output_dir.empty() ? fs::path(fs::path(args.case_file).stem().string() + ".out") : fs::path(args.output_dir);
@@ -171,10 +174,7 @@ int run_case(const RunArguments& args) {
     save_checkpoint(checkpoint, m, r.iteration, r.time);
   };
 
-  g_interrupted.store(false);
-  auto previous = std::signal(SIGINT, on_sigint);
   EvolutionResult result = evolve(mesh, model.model(), options);
-  std::signal(SIGINT, previous);
 
   if (result.reason == StopReason::Interrupted) {
     spdlog::warn("interrupted: iteration {} (t = {}) is complete and saved; continue with --resume", result.iteration,
