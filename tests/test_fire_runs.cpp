@@ -211,3 +211,18 @@ TEST_CASE("a fuel map's non-burnable cells stop the front") {
   CHECK(x_max <= 700 + 2 * h);                     // stopped within one cell of P1 interpolation of the speed
   CHECK(std::abs((500 - r0 - x_min) - free_run) / free_run < 0.02);  // the other side burns at R0
 }
+
+TEST_CASE("the fire cases of meshes/cases are valid and configure the plugin") {
+  // The [model] paths (fuel map, arrival raster) are relative to the working directory: the
+  // repository root, as docs/fire.md says.
+  const auto previous = std::filesystem::current_path();
+  std::filesystem::current_path(test::source_path("."));
+  for (const char* name : {"fire_one_disk", "fire_four_disks", "fire_rotating_wind", "fire_luxembourg"}) {
+    CAPTURE(name);
+    CaseConfig c = read_case(test::source_path(std::string("meshes/cases/") + name + ".toml"));
+    CHECK(c.model == "fire");
+    LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
+    CHECK_NOTHROW(configure_model(model, c.model_parameters));
+  }
+  std::filesystem::current_path(previous);
+}
