@@ -3,7 +3,7 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 
-#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCholesky>
 #include <fmt/format.h>
 
 #include <stdexcept>
@@ -68,8 +68,11 @@ struct H1Smoother::Impl {
   double length = 0;
   Eigen::SparseMatrix<double> mass;
   VectorField normals;
-  // Supernodal Cholesky of M + ℓ²K (absent when ℓ = 0: the identity map).
-  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>> factor;
+  // Sparse Cholesky (LDLᵀ, AMD ordering) of M + ℓ²K, absent when ℓ = 0 (the identity map).
+  // Eigen's own solver, not CHOLMOD: CHOLMOD's supernodal module is GPL, and the core stays
+  // under a permissive licence (see LICENSE); models that need CHOLMOD's speed link it themselves.
+  using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  std::unique_ptr<Factor> factor;
 
   Eigen::MatrixXd solve(const Eigen::MatrixXd& f) const {
     if (f.rows() != mass.rows())
@@ -77,7 +80,7 @@ struct H1Smoother::Impl {
                                               mass.rows()));
     Eigen::MatrixXd rhs = mass * f;
     Eigen::MatrixXd u = factor->solve(rhs);
-    if (factor->info() != Eigen::Success) throw std::runtime_error("H1 smoothing: CHOLMOD solve failed");
+    if (factor->info() != Eigen::Success) throw std::runtime_error("H1 smoothing: sparse Cholesky solve failed");
     return u;
   }
 };
@@ -97,7 +100,7 @@ H1Smoother::H1Smoother(const Eigen::SparseMatrix<double>& mass, const Eigen::Spa
   if (length == 0) return;
   impl_->mass = mass;
   Eigen::SparseMatrix<double> system = mass + (length * length) * stiffness;
-  impl_->factor = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>>>();
+  impl_->factor = std::make_unique<Impl::Factor>();
   impl_->factor->compute(system);
   if (impl_->factor->info() != Eigen::Success)
     throw InputError("H1 smoothing: M + l^2 K is not positive definite (isolated vertex or degenerate mesh)");

@@ -2,8 +2,8 @@
 // P1 finite elements on a triangulated surface: mass and stiffness matrices, lumped mass, and the
 // H¹ smoothing (M + ℓ²K) u = M f used to regularise velocities and extend them off the front.
 //
-// Matrices are vertex-indexed (the mesh must be garbage-collected). The Cholesky factorisation
-// (CHOLMOD) stays behind H1Smoother so that the core's users do not need CHOLMOD's headers.
+// Matrices are vertex-indexed (the mesh must be garbage-collected). The sparse Cholesky
+// factorisation (Eigen's LDLᵀ, permissively licensed) stays behind H1Smoother.
 #include <bodyfit/mesh.hpp>
 
 #include <Eigen/SparseCore>
