@@ -219,7 +219,12 @@ TEST_CASE("open plane: inflow vertices take the boundary values at the exit poin
     CAPTURE(V);
     const double T = 0.31;  // not a multiple of h: exit points fall inside boundary edges
     AdvectionReport report;
-    const ScalarField result = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, {}, &report);
+    AdvectionOptions p1;  // the boundary value is exactly the P1 trace without the correction
+    p1.gradient_correction = false;
+    const ScalarField result = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, p1, &report);
+    // With the correction, exit values stay within the P1 interpolation bound of the exact trace.
+    const ScalarField corrected = advect(mesh, phi, VectorField(mesh.n_vertices(), V), T, {});
+    double worst_corrected = 0;
     CHECK(report.lost == 0);
     std::size_t inflow = 0;
     double worst = 0;
@@ -233,9 +238,12 @@ TEST_CASE("open plane: inflow vertices take the boundary values at the exit poin
       if (foot[0] > 1e-12) continue;  // leaves through y = 0, not the side checked here
       ++inflow;
       worst = std::max(worst, std::abs(result[v.idx()] - boundary_value(foot[1])));
+      worst_corrected = std::max(worst_corrected, std::abs(corrected[v.idx()] - phi0(foot[0], foot[1])));
     }
     CHECK(inflow > 0);
     CHECK(worst < 1e-12);
+    // |∂²φ0/∂y²| ≤ 9: P1 interpolation on an edge of length h is within 9h²/8 of the exact value.
+    CHECK(worst_corrected <= 9.0 / (8.0 * n * n));
   }
   // Horizontal flow: the bottom and top rows run along boundary edges and must not stop there.
   AdvectionReport report;

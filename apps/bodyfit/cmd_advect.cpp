@@ -35,6 +35,9 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
   cmd->add_option("--rk", args->options.rk_order, "Runge-Kutta order of the tracing (2 or 4)")
       ->capture_default_str()
       ->check(CLI::IsMember({2, 4}));
+  cmd->add_flag("--p1{false}", args->options.gradient_correction,
+                "plain P1 interpolation at the feet (default: P1 averaged with the vertex-gradient Taylor "
+                "expansions, which removes the O(h²) interpolation bias)");
   cmd->add_option("--cells", args->options.max_cells_per_substep, "edge lengths crossed per sub-step, at most about")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

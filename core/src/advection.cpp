@@ -399,6 +399,13 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
 
   const int nv = int(mesh.n_vertices());
   ScalarField out(nv, 0.0);
+  VectorField gradients;
+  std::vector<Vec3> points;
+  if (options.gradient_correction) {
+    gradients = vertex_gradients(mesh, phi);
+    points.resize(std::size_t(nv));
+    for (auto vh : mesh.vertices()) points[std::size_t(vh.idx())] = mesh.point(vh);
+  }
   std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, nv, 256), [&](const tbb::blocked_range<int>& range) {
     std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0;
@@ -415,7 +422,18 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
       start.b[s.vertex_slot[v]] = 1.0;
       const TraceResult r = trace(s, start, T, options);
       const std::array<int, 3>& c = s.corners[r.foot.face];
-      out[v] = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
+      double value = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
+      if (options.gradient_correction) {
+        const Vec3 x = r.foot.b[0] * points[c[0]] + r.foot.b[1] * points[c[1]] + r.foot.b[2] * points[c[2]];
+        double taylor = 0, lo = phi[c[0]], hi = phi[c[0]];
+        for (int j = 0; j < 3; ++j) {
+          taylor += r.foot.b[j] * (phi[c[j]] + OpenMesh::dot(gradients[c[j]], x - points[c[j]]));
+          lo = std::min(lo, phi[c[j]]);
+          hi = std::max(hi, phi[c[j]]);
+        }
+        value = std::clamp(0.5 * (value + taylor), lo, hi);
+      }
+      out[v] = value;
       ++local_traced;
       local_sub += r.substeps;
       local_boundary += r.boundary;

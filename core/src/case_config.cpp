@@ -392,6 +392,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     out.max_cells_per_substep = s.positive("max_cells_per_substep", out.max_cells_per_substep);
     out.steps = int(s.integer("steps", out.steps));
     if (out.steps < 1) s.fail("steps: must be ≥ 1");
+    out.gradient_correction = s.boolean("gradient_correction", out.gradient_correction);
     s.check_unknown();
   }
   {  // [discretize]

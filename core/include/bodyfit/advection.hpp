@@ -11,6 +11,12 @@ struct AdvectionOptions {
   /// Sub-steps are sized so that one crosses at most about this many local edge lengths.
   double max_cells_per_substep = 1.0;
   int steps = 1;               ///< outer steps over (0, T) (the velocity is frozen anyway)
+  /// Value at the foot: false = P1 interpolation of φ0; true = the mean of the P1 interpolation and
+  /// of the barycentric average of the vertices' first-order Taylor expansions (vertex gradients),
+  /// clamped to the face's range. The two have opposite O(h²) errors (P1 over-estimates a convex φ0
+  /// such as a distance function, the Taylor planes under-estimate it), so the mean removes the
+  /// inward drift of a convex front that P1 interpolation causes at every step.
+  bool gradient_correction = true;
 };
 
 struct AdvectionReport {
