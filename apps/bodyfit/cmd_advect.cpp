@@ -16,6 +16,7 @@ struct AdvectArguments {
   std::string mesh, phi, velocity, output;
   double time = 0;
   bodyfit::AdvectionOptions options;
+  bool plain_p1 = false;
 };
 
 double ms_since(std::chrono::steady_clock::time_point start) {
@@ -35,7 +36,7 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
   cmd->add_option("--rk", args->options.rk_order, "Runge-Kutta order of the tracing (2 or 4)")
       ->capture_default_str()
       ->check(CLI::IsMember({2, 4}));
-  cmd->add_flag("--p1{false}", args->options.gradient_correction,
+  cmd->add_flag("--p1", args->plain_p1,
                 "plain P1 interpolation at the feet (default: P1 averaged with the vertex-gradient Taylor "
                 "expansions, which removes the O(h²) interpolation bias)");
   cmd->add_option("--cells", args->options.max_cells_per_substep, "edge lengths crossed per sub-step, at most about")
@@ -50,6 +51,7 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
             const double read_ms = ms_since(start);
             const auto advect_start = std::chrono::steady_clock::now();
             bodyfit::AdvectionReport report;
+            args->options.gradient_correction = !args->plain_p1;
             const auto result = bodyfit::advect(mesh, phi, velocity, args->time, args->options, &report);
             const double advect_ms = ms_since(advect_start);
             bodyfit::write_scalar_sol(args->output, result);
