@@ -1,4 +1,5 @@
 #include <bodyfit/case_config.hpp>
+#include <bodyfit/parameters.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
@@ -13,21 +14,6 @@
 
 namespace bodyfit {
 namespace {
-
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
 
 std::string where(const toml::node& node) {
   const auto& source = node.source();
@@ -84,7 +70,7 @@ class Section {
   std::string choice(const std::string& key, const std::vector<std::string>& choices, const std::string& fallback) {
     std::string v = string(key, fallback);
     if (std::find(choices.begin(), choices.end(), v) != choices.end()) return v;
-    std::string hint = closest_word(v, choices);
+    std::string hint = closest_match(v, choices);
     throw InputError(fmt::format("[{}] {}: unknown value '{}'{}; expected one of: {}", name_, key, v,
                                  hint.empty() ? "" : fmt::format(" (did you mean '{}'?)", hint),
                                  fmt::join(choices, ", ")));
@@ -113,7 +99,7 @@ class Section {
     for (auto&& [key, value] : *table_) {
       std::string k(key.str());
       if (std::find(known_.begin(), known_.end(), k) != known_.end()) continue;
-      std::string hint = closest_word(k, known_);
+      std::string hint = closest_match(k, known_);
       throw InputError(fmt::format("unknown key '{}' in [{}]{}{}", k, name_, where(value),
                                    hint.empty() ? "" : fmt::format("; did you mean '{}'?", hint)));
     }
@@ -182,16 +168,6 @@ SurfaceMesh make_plane(double size, double h) {
 
 }  // namespace
 
-std::string closest_word(const std::string& word, const std::vector<std::string>& candidates) {
-  std::string best;
-  std::size_t best_distance = std::max<std::size_t>(2, word.size() / 3) + 1;
-  for (const auto& c : candidates) {
-    std::size_t d = edit_distance(word, c);
-    if (d < best_distance) best_distance = d, best = c;
-  }
-  return best;
-}
-
 void apply_override(toml::table& table, const std::string& assignment) {
   auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
@@ -231,7 +207,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
   for (auto&& [key, value] : table) {
     std::string k(key.str());
     if (std::find(kSections.begin(), kSections.end(), k) == kSections.end()) {
-      std::string hint = closest_word(k, kSections);
+      std::string hint = closest_match(k, kSections);
       throw InputError(fmt::format("unknown table [{}]{}{}", k, where(value),
                                    hint.empty() ? "" : fmt::format("; did you mean '{}'?", hint)));
     }

@@ -95,8 +95,6 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
 /// Read a case file, apply the overrides in order, validate.
 CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 
-/// The closest word of `candidates` to `word` (edit distance ≤ max(2, |word|/3)), or "".
-std::string closest_word(const std::string& word, const std::vector<std::string>& candidates);
 
 /// The surface S of the case (generated or read), without region labels.
 SurfaceMesh make_case_surface(const CaseConfig& config);
