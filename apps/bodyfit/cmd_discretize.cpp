@@ -1,6 +1,7 @@
 // bodyfit discretize: cut the zero level set of φ into the mesh and remesh (the job of `mmgs -ls 0`):
 // the output carries the regions (refs 3 inside, 2 outside) and the interface edges (ref 10).
 #include "commands.hpp"
+#include "remesh_options.hpp"
 
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
@@ -45,12 +46,7 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
                   "put a vertex on the level set when the crossing is closer than this fraction of the edge")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.5));
-  cmd->add_option("--hmin", options->hmin, "smallest edge length (default hmax/20)");
-  cmd->add_option("--hmax", options->hmax, "largest edge length (default bounding-box diagonal/20)");
-  cmd->add_option("--hausd", options->hausd, "allowed distance to the surface and interface (default diagonal/1000)");
-  cmd->add_option("--hgrad", options->hgrad, "gradation between neighbouring sizes")->capture_default_str();
-  cmd->add_option("--angle", options->feature_angle, "ridge detection angle in degrees, <= 0 disables")
-      ->capture_default_str();
+  bodyfit::cli::add_remesh_options(*cmd, *options);
   cmd->add_flag("--no-remesh", *no_remesh, "only cut the level set in (thin triangles remain)");
   return {cmd, [=]() {
             Stopwatch clock;

@@ -1,6 +1,7 @@
 // bodyfit remesh: interface-preserving adaptive remeshing of a Medit mesh (the `mmgs -ls` step
 // after a cut), keeping regions, interface, ridges, corners, boundaries and required entities.
 #include "commands.hpp"
+#include "remesh_options.hpp"
 
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
@@ -20,12 +21,7 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
   auto options = std::make_shared<bodyfit::RemeshOptions>();
   cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", *output, "output mesh (.mesh keeps refs, readable by MMG)")->required();
-  cmd->add_option("--hmin", options->hmin, "smallest edge length (default hmax/20)");
-  cmd->add_option("--hmax", options->hmax, "largest edge length (default bounding-box diagonal/20)");
-  cmd->add_option("--hausd", options->hausd, "allowed distance to the surface and interface (default diagonal/1000)");
-  cmd->add_option("--hgrad", options->hgrad, "gradation between neighbouring sizes")->capture_default_str();
-  cmd->add_option("--angle", options->feature_angle, "ridge detection angle in degrees, <= 0 disables")
-      ->capture_default_str();
+  bodyfit::cli::add_remesh_options(*cmd, *options);
   cmd->add_option("--passes", options->max_passes, "maximum split/collapse/flip/relocate passes")->capture_default_str();
   cmd->add_flag("--full", [options](std::int64_t) { options->incremental = false; },
                 "work on every vertex, not only where the mesh needs change");
