@@ -7,6 +7,8 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 #include <test_support.hpp>
 
@@ -21,19 +23,7 @@ using namespace bodyfit;
 namespace {
 
 /// The unit square [0, 1]² in the plane z = 0, n × n cells, each cut along its (1, 1) diagonal.
-SurfaceMesh make_square(int n) {
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> v;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(double(i) / n, double(j) / n, 0)));
-  auto at = [&](int i, int j) { return v[j * (n + 1) + i]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
-      mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
-    }
-  return mesh;
-}
+SurfaceMesh make_square(int n) { return test::grid_square(n); }
 
 ScalarField sample(const SurfaceMesh& mesh, const std::function<double(const Vec3&)>& f) {
   ScalarField values(mesh.n_vertices());

@@ -8,6 +8,8 @@
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/validate.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 #include <test_support.hpp>
 
@@ -25,19 +27,7 @@ constexpr double pi = std::numbers::pi;
 
 /// The unit square [0, 1]² cut into n × n cells, each split along its (0,0)-(1,1) diagonal,
 /// oriented with normals +z.
-SurfaceMesh make_square(int n) {
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> v;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(double(i) / n, double(j) / n, 0)));
-  auto at = [&](int i, int j) { return v[std::size_t(j * (n + 1) + i)]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
-      mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
-    }
-  return mesh;
-}
+SurfaceMesh make_square(int n) { return test::grid_square(n); }
 
 ScalarField sample(const SurfaceMesh& mesh, const std::function<double(const Vec3&)>& f) {
   ScalarField values(mesh.n_vertices());

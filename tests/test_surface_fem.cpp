@@ -5,6 +5,8 @@
 #include <bodyfit/step_context.hpp>
 #include <bodyfit/surface_fem.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -18,24 +20,7 @@ namespace {
 
 /// The unit square [0,1]² triangulated on an n×n grid, diagonals alternating so that the mesh is
 /// not symmetric in an accidental way.
-SurfaceMesh flat_square(int n) {
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> v;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(double(i) / n, double(j) / n, 0)));
-  auto at = [&](int i, int j) { return v[j * (n + 1) + i]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      if ((i + j) % 2 == 0) {
-        mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
-        mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
-      } else {
-        mesh.add_face(at(i, j), at(i + 1, j), at(i, j + 1));
-        mesh.add_face(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-      }
-    }
-  return mesh;
-}
+SurfaceMesh flat_square(int n) { return test::grid_square(n, {.alternate_diagonals = true}); }
 
 double sum_of_entries(const Eigen::SparseMatrix<double>& m) { return Eigen::MatrixXd(m).sum(); }
 

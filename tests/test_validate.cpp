@@ -4,6 +4,8 @@
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/validate.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 
 #include <string>
@@ -14,19 +16,7 @@ namespace {
 
 /// The unit square in n × n cells split along the (0,0)-(1,1) diagonals; the corner (1, 0)
 /// belongs to a single face.
-SurfaceMesh make_square(int n) {
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> v;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(double(i) / n, double(j) / n, 0)));
-  auto at = [&](int i, int j) { return v[std::size_t(j * (n + 1) + i)]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
-      mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
-    }
-  return mesh;
-}
+SurfaceMesh make_square(int n) { return test::grid_square(n); }
 
 /// A sphere with a polar cap cut in as the inside region.
 SurfaceMesh sphere_with_cap() {

@@ -1,6 +1,7 @@
 #include "test_support.hpp"
 
 #include <array>
+#include <vector>
 #include <atomic>
 #include <cstdio>
 #include <sys/wait.h>
@@ -32,6 +33,26 @@ CommandResult run_bodyfit(const std::string& arguments) {
   int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+SurfaceMesh grid_square(int n, const GridSquare& o) {
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> v;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i)
+      v.push_back(mesh.add_vertex(Vec3(o.x0 + (o.x1 - o.x0) * i / n, o.y0 + (o.y1 - o.y0) * j / n, 0)));
+  auto at = [&](int i, int j) { return v[std::size_t(j * (n + 1) + i)]; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      if (!o.alternate_diagonals || (i + j) % 2 == 0) {
+        mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+        mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+      } else {
+        mesh.add_face(at(i, j), at(i + 1, j), at(i, j + 1));
+        mesh.add_face(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+      }
+    }
+  return mesh;
 }
 
 std::filesystem::path source_path(const std::string& relative) {

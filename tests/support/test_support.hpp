@@ -1,5 +1,7 @@
 #pragma once
 // Shared helpers of the test suite: temporary directories, running the bodyfit executable.
+#include <bodyfit/mesh.hpp>
+
 #include <filesystem>
 #include <string>
 
@@ -23,6 +25,14 @@ struct CommandResult {
 };
 /// Run `bodyfit <arguments>` and capture its output.
 CommandResult run_bodyfit(const std::string& arguments);
+
+/// A flat n×n grid of squares over [x0, x1]×[y0, y1] (z = 0), each split into two triangles along
+/// the same diagonal, or along alternating diagonals (a symmetric "union jack"-like pattern).
+struct GridSquare {
+  double x0 = 0, y0 = 0, x1 = 1, y1 = 1;
+  bool alternate_diagonals = false;
+};
+SurfaceMesh grid_square(int n, const GridSquare& options = {});
 
 /// Path of a file in the source tree (e.g. "meshes/cube.mesh").
 std::filesystem::path source_path(const std::string& relative);
