@@ -5,10 +5,13 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 #include <test_support.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -57,22 +60,7 @@ double cap_exact(const Vec3& p) { return polar_angle(p) - kCap; }
 /// The square [x0, x1] × [y0, y1] in the plane z = 0, n × n cells, each split into two right
 /// triangles along alternating diagonals.
 SurfaceMesh make_square(int n, double x0 = -1, double y0 = -1, double x1 = 1, double y1 = 1) {
-  SurfaceMesh mesh;
-  std::vector<VertexHandle> v;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) v.push_back(mesh.add_vertex(Vec3(x0 + (x1 - x0) * i / n, y0 + (y1 - y0) * j / n, 0)));
-  auto at = [&](int i, int j) { return v[std::size_t(j * (n + 1) + i)]; };
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      if ((i + j) % 2 == 0) {
-        mesh.add_face(at(i, j), at(i + 1, j), at(i + 1, j + 1));
-        mesh.add_face(at(i, j), at(i + 1, j + 1), at(i, j + 1));
-      } else {
-        mesh.add_face(at(i, j), at(i + 1, j), at(i, j + 1));
-        mesh.add_face(at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-      }
-    }
-  return mesh;
+  return test::grid_square(n, {x0, y0, x1, y1, true});
 }
 
 /// A strip of flat obtuse triangles: rows of spacing 0.35·h shifted by h/2 on odd rows, so every
@@ -206,7 +194,9 @@ TEST_CASE("distance from region labels equals distance from a level set that is 
       REQUIRE_FALSE((phi[mesh.to_vertex_handle(h).idx()] == 0 && phi[mesh.from_vertex_handle(h).idx()] == 0));
   }
   DistanceReport from_labels_report;
-  const ScalarField from_labels = signed_distance_to_region(mesh, {}, &from_labels_report);
+  // The polygon of interface edges (its staircase turns are mostly sharp anyway) is the zero set
+  // of the P1 φ.
+  const ScalarField from_labels = signed_distance_to_region(mesh, {.curved_interface = false}, &from_labels_report);
   const ScalarField from_phi = signed_distance(mesh, phi);
   CHECK(from_labels_report.has_interface);
   double worst = 0;
@@ -215,6 +205,79 @@ TEST_CASE("distance from region labels equals distance from a level set that is 
   // And it is the distance to the staircase interface: within a couple of edge lengths of the cap's.
   const double h = edge_length_stats(mesh).mean;
   for (auto v : mesh.vertices()) CHECK(std::abs(from_labels[v.idx()] - cap_exact(mesh.point(v))) < h);
+}
+
+/// A band β ∈ [a − 0.4, a + 0.4] of the unit sphere (β the polar angle) with rows of n vertices
+/// at β = a + kΔβ, odd rows shifted by half a column so that the vertices next to the circle
+/// β = a sit in front of the middle of its chords; the faces above that circle are inside.
+SurfaceMesh make_cap_band(int n, double a) {
+  const double dlambda = 2 * std::numbers::pi / n;
+  const double dbeta = std::sqrt(3.0) / 2 * dlambda * std::sin(a);
+  const int half = int(std::ceil(0.4 / dbeta));
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> v;
+  for (int j = 0; j <= 2 * half; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double beta = a + (j - half) * dbeta, lambda = (i + 0.5 * (j % 2)) * dlambda;
+      v.push_back(mesh.add_vertex(
+          Vec3(std::sin(beta) * std::cos(lambda), std::sin(beta) * std::sin(lambda), std::cos(beta))));
+    }
+  // (row, unwrapped column) corners; ordered counter-clockwise in (β, λ), i.e. outward.
+  auto add = [&](std::array<std::pair<int, int>, 3> c) {
+    auto x = [](std::pair<int, int> p) { return p.second + 0.5 * (p.first % 2); };
+    const double cross = (c[1].first - c[0].first) * (x(c[2]) - x(c[0])) - (x(c[1]) - x(c[0])) * (c[2].first - c[0].first);
+    if (cross < 0) std::swap(c[1], c[2]);
+    std::array<VertexHandle, 3> h;
+    for (int k = 0; k < 3; ++k) h[k] = v[std::size_t(c[k].first * n + (c[k].second % n))];
+    const auto f = mesh.add_face(h[0], h[1], h[2]);
+    mesh.region(f) = std::max({c[0].first, c[1].first, c[2].first}) <= half ? kInside : kOutside;
+  };
+  for (int j = 0; j < 2 * half; ++j)
+    for (int i = 0; i < n; ++i) {
+      if (j % 2 == 0) {
+        add({{{j, i}, {j, i + 1}, {j + 1, i}}});
+        add({{{j, i + 1}, {j + 1, i + 1}, {j + 1, i}}});
+      } else {
+        add({{{j, i}, {j + 1, i + 1}, {j + 1, i}}});
+        add({{{j, i}, {j, i + 1}, {j + 1, i + 1}}});
+      }
+    }
+  update_interface_from_regions(mesh);
+  return mesh;
+}
+
+TEST_CASE("region labels of a cap whose interface vertices lie on its circle: the curved interface removes the sagitta") {
+  // The chords of the circle β = a lie inside it by up to the sagitta κL²/8 (geodesic curvature
+  // κ = cot a): the polygon's distance carries that error, the arcs leave O(L³).
+  std::vector<double> off_errors, on_errors, lengths;
+  for (int n : {48, 96}) {
+    const SurfaceMesh mesh = make_cap_band(n, kCap);
+    const double chord = 2 * std::sin(kCap) * std::sin(std::numbers::pi / n);
+    const double sagitta = chord * chord / std::tan(kCap) / 8;
+    auto near_error = [&](const ScalarField& d) {
+      double worst = 0;
+      for (auto v : mesh.vertices()) {
+        const double exact = cap_exact(mesh.point(v));
+        REQUIRE((d[v.idx()] < 0) == (exact < -1e-12));
+        if (std::abs(exact) < 2 * chord) worst = std::max(worst, std::abs(d[v.idx()] - exact));
+      }
+      return worst;
+    };
+    const double off = near_error(signed_distance_to_region(mesh, {.curved_interface = false}));
+    const double on = near_error(signed_distance_to_region(mesh));
+    INFO("n ", n, ": sagitta ", sagitta, ", polygon error ", off, ", curved error ", on);
+    CHECK(off > 0.7 * sagitta);
+    CHECK(on < 0.2 * off);
+    off_errors.push_back(off);
+    on_errors.push_back(on);
+    lengths.push_back(chord);
+  }
+  const double ratio = std::log(lengths[0] / lengths[1]);
+  const double off_order = std::log(off_errors[0] / off_errors[1]) / ratio;
+  const double on_order = std::log(on_errors[0] / on_errors[1]) / ratio;
+  INFO("polygon order ", off_order, ", curved order ", on_order);
+  CHECK(off_order < 2.3);
+  CHECK(on_order > 2.7);
 }
 
 TEST_CASE("flat square, disk region: the Euclidean distance |x − c| − r") {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <queue>
 #include <utility>
 #include <vector>
@@ -221,6 +222,20 @@ double point_segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   return (p - (a + e * t)).norm();
 }
 
+/// Distance from p to the arc x(t), t ∈ [0, 1], from a to b whose curvature vector (towards the
+/// centre) goes linearly from ka to kb: x'' = |b − a|²·((1−t)·ka + t·kb) departs from the chord by
+/// −|b − a|²·t(1−t)·((2−t)·ka + (1+t)·kb)/6, towards the convex side (κL²/8 at the middle for a
+/// circle). Evaluated at the foot of p on the chord, which moves the nearest point by O(h²κ) along
+/// the curve and changes the distance only at O(h³).
+double point_arc_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& ka, const Vec3& kb) {
+  const Vec3 e = b - a;
+  const double len2 = e.sqrnorm();
+  double t = len2 > 0 ? ((p - a) | e) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  const Vec3 bulge = (ka * (2 - t) + kb * (1 + t)) * (-len2 * t * (1 - t) / 6);
+  return (p - (a + e * t) - bulge).norm();
+}
+
 /// What the initialisation needs: the sign of each vertex (−1, 0, +1) and, for every face touched
 /// by the interface, the interface segments inside it.
 struct Seeds {
@@ -228,6 +243,7 @@ struct Seeds {
   std::vector<int> faces;                       // seed faces
   std::vector<int> seg_start;                   // per seed face, into segments (CSR)
   std::vector<std::pair<Vec3, Vec3>> segments;  // a point is a segment with equal ends
+  std::vector<std::pair<Vec3, Vec3>> bends;     // empty, or per segment the curvature vectors at its ends
 };
 
 Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
@@ -257,8 +273,63 @@ Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
   return s;
 }
 
-Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m) {
+/// Curvature vector of the interface curve (towards the centre of the circle through a vertex and
+/// its two interface neighbours, projected on the tangent plane of S: the geodesic curvature) at
+/// each interface vertex where the curve is smooth. `smooth` is false at the vertices of
+/// interface-degree ≠ 2, on the boundary of S, or where the curve turns by more than 30°.
+void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector<Vec3>& curvature,
+                         std::vector<char>& smooth) {
+  std::vector<std::array<int, 2>> neighbour(m.nv, {-1, -1});
+  std::vector<int> degree(m.nv, 0);
+  for (auto e : mesh.edges()) {
+    if (!mesh.interface(e)) continue;
+    const auto h = mesh.halfedge_handle(e, 0);
+    const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+    if (degree[a] < 2) neighbour[a][degree[a]] = b;
+    if (degree[b] < 2) neighbour[b][degree[b]] = a;
+    ++degree[a];
+    ++degree[b];
+  }
+  const double cos_max_turn = std::cos(std::numbers::pi / 6);
+  curvature.assign(m.nv, Vec3(0, 0, 0));
+  smooth.assign(m.nv, 0);
+  for (std::size_t v = 0; v < m.nv; ++v) {
+    if (degree[v] != 2 || mesh.is_boundary(VertexHandle(int(v)))) continue;
+    const Vec3& x = m.points[v];
+    const Vec3 u = m.points[neighbour[v][0]] - x, w = m.points[neighbour[v][1]] - x;
+    // The turn between the segments (x − u-end) and (w-end − x) has cosine −u·w / (|u||w|).
+    if (-(u | w) < cos_max_turn * u.norm() * w.norm()) continue;
+    smooth[v] = 1;
+    const Vec3 uw = u % w;
+    const double uw2 = uw.sqrnorm();
+    if (uw2 == 0) continue;  // collinear: straight
+    const Vec3 centre = ((w * u.sqrnorm() - u * w.sqrnorm()) % uw) / (2 * uw2);  // circumcentre − x
+    Vec3 k = centre / centre.sqrnorm();
+    Vec3 normal(0, 0, 0);
+    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
+      normal += (m.points[m.fan[j].a] - x) % (m.points[m.fan[j].b] - x);
+    const double length = normal.norm();
+    if (length > 0) {
+      normal /= length;
+      k -= normal * (k | normal);
+    }
+    curvature[v] = k;
+  }
+}
+
+Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved) {
   Seeds s;
+  std::vector<Vec3> curvature;
+  std::vector<char> smooth;
+  if (curved) interface_curvature(mesh, m, curvature, smooth);
+  const Vec3 zero(0, 0, 0);
+  // An interface edge bends only when both its ends are smooth curve points.
+  auto add_segment = [&](int a, int b) {
+    s.segments.emplace_back(m.points[a], m.points[b]);
+    if (!curved) return;
+    if (a != b && smooth[a] && smooth[b]) s.bends.emplace_back(curvature[a], curvature[b]);
+    else s.bends.emplace_back(zero, zero);
+  };
   s.sign.assign(m.nv, 1);
   for (std::size_t f = 0; f < m.nf; ++f)
     if (mesh.inside(FaceHandle(int(f))))
@@ -279,10 +350,10 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m) {
     for (auto h : {h0, mesh.next_halfedge_handle(h0), mesh.prev_halfedge_handle(h0)}) {
       const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
       if (mesh.interface(mesh.edge_handle(h))) {
-        s.segments.emplace_back(m.points[a], m.points[b]);
+        add_segment(a, b);
         seed = true;
       } else if (on_interface[a]) {
-        s.segments.emplace_back(m.points[a], m.points[a]);
+        add_segment(a, a);
         seed = true;
       }
     }
@@ -338,8 +409,12 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
     for (int w : ring) {
       const Vec3& p = m.points[w];
       double best = dist[w];
-      for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k)
-        best = std::min(best, point_segment_distance(p, seeds.segments[k].first, seeds.segments[k].second));
+      for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k) {
+        const auto& [a, b] = seeds.segments[k];
+        best = std::min(best, seeds.bends.empty()
+                                  ? point_segment_distance(p, a, b)
+                                  : point_arc_distance(p, a, b, seeds.bends[k].first, seeds.bends[k].second));
+      }
       dist[w] = best;
     }
   }
@@ -458,7 +533,8 @@ ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi, con
 
 ScalarField signed_distance_to_region(const SurfaceMesh& mesh, const DistanceOptions& options,
                                       DistanceReport* report) {
-  return run(mesh, options, report, [&](const FlatMesh& m) { return seeds_from_region(mesh, m); });
+  return run(mesh, options, report,
+             [&](const FlatMesh& m) { return seeds_from_region(mesh, m, options.curved_interface); });
 }
 
 }  // namespace bodyfit

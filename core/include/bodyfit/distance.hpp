@@ -9,6 +9,13 @@ namespace bodyfit {
 struct DistanceOptions {
   /// Stop marching beyond this |d| (narrow band); vertices beyond keep ±infinity.
   double narrow_band = std::numeric_limits<double>::infinity();
+  /// Region mode: measure the distance to the smooth curve through the interface vertices, not to
+  /// the polygon of interface edges. Each edge is taken as an arc bending with the curvature
+  /// estimated at its two ends (circle through each vertex and its two neighbours, in the tangent
+  /// plane): the chord lies O(h²κ) inside a convex curve, the arc removes that bias (O(h³) left).
+  /// Edges with an end that is not a smooth curve point (interface-degree ≠ 2, on the boundary of
+  /// S, or a turn above 30°) stay straight. The φ mode ignores it (its zero set is O(h²) anyway).
+  bool curved_interface = true;
 };
 
 struct DistanceReport {
