@@ -5,8 +5,6 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
 
-#include "test_support.hpp"
-
 #include <doctest/doctest.h>
 #include <test_support.hpp>
 
