@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 
 namespace bodyfit {
@@ -206,8 +207,90 @@ SurfacePoint ReferenceSurface::closest(const Vec3& p, int hint) const {
 void ReferencePolyline::add(const Vec3& a, const Vec3& b, int label) {
   a_.push_back(a);
   b_.push_back(b);
+  da_.push_back(b - a);
+  db_.push_back(b - a);
+  smooth_.push_back(0);
   label_.push_back(label);
   built_ = false;
+}
+
+void ReferencePolyline::smooth(int label, double corner_angle) {
+  // Segment ends meeting at each vertex (end 0 = a, 1 = b), vertices matched by exact coordinates.
+  std::map<std::array<double, 3>, std::vector<std::pair<int, int>>> ends;
+  auto key = [](const Vec3& p) { return std::array<double, 3>{p[0], p[1], p[2]}; };
+  for (std::size_t i = 0; i < a_.size(); ++i)
+    if (label_[i] == label) {
+      ends[key(a_[i])].emplace_back(int(i), 0);
+      ends[key(b_[i])].emplace_back(int(i), 1);
+    }
+  // Unit tangents at each segment end, oriented a → b; zero = not determined by a smooth vertex.
+  std::vector<std::array<Vec3, 2>> unit(a_.size(), {Vec3(0, 0, 0), Vec3(0, 0, 0)});
+  const double cos_corner = std::cos(corner_angle);
+  for (const auto& [k, list] : ends) {
+    if (list.size() != 2) continue;
+    Vec3 p(k[0], k[1], k[2]);
+    auto other = [&](std::pair<int, int> e) { return e.second == 0 ? b_[e.first] : a_[e.first]; };
+    Vec3 d0 = p - other(list[0]), d1 = other(list[1]) - p;  // q0 → p → q1
+    double l0 = d0.norm(), l1 = d1.norm();
+    if (l0 <= 0 || l1 <= 0) continue;
+    if ((d0 | d1) / (l0 * l1) < cos_corner) continue;  // a corner: one-sided tangents
+    // Bessel: derivative at p of the parabola through q0, p, q1 parametrised by chord length.
+    Vec3 t = d0 * (l1 / (l0 * (l0 + l1))) + d1 * (l0 / (l1 * (l0 + l1)));
+    double lt = t.norm();
+    if (lt <= 0) continue;
+    t /= lt;
+    for (auto e : list) {
+      Vec3 chord = b_[e.first] - a_[e.first];
+      unit[e.first][e.second] = (t | chord) >= 0 ? t : -t;
+    }
+  }
+  for (std::size_t i = 0; i < a_.size(); ++i) {
+    if (label_[i] != label) continue;
+    Vec3 chord = b_[i] - a_[i];
+    double l = chord.norm();
+    if (l <= 0) continue;
+    Vec3 c = chord / l;
+    auto one_sided = [&](const Vec3& known) {
+      if (known.sqrnorm() == 0) return c;
+      // Mirror of the other end's tangent about the chord: what a circular arc would have.
+      Vec3 m = c * (2 * (c | known)) - known;
+      return (m | c) > 0.5 ? m : c;
+    };
+    Vec3 ta = unit[i][0], tb = unit[i][1];
+    if (ta.sqrnorm() == 0) ta = one_sided(tb);
+    if (tb.sqrnorm() == 0) tb = one_sided(unit[i][0]);
+    da_[i] = ta * l;
+    db_[i] = tb * l;
+    smooth_[i] = 1;
+  }
+  built_ = false;
+}
+
+Vec3 ReferencePolyline::point(std::size_t i, double t) const {
+  double t2 = t * t, t3 = t2 * t;
+  return a_[i] * (2 * t3 - 3 * t2 + 1) + da_[i] * (t3 - 2 * t2 + t) + b_[i] * (3 * t2 - 2 * t3) + db_[i] * (t3 - t2);
+}
+
+Vec3 ReferencePolyline::closest_on(std::size_t i, const Vec3& p) const {
+  Vec3 chord = b_[i] - a_[i];
+  double l2 = chord.sqrnorm();
+  double t = l2 > 0 ? std::clamp(((p - a_[i]) | chord) / l2, 0.0, 1.0) : 0.0;
+  if (!smooth_[i]) return a_[i] + chord * t;
+  // Newton on |C(t) − p|², started from the chord's parameter (the arc is within the sagitta of it).
+  const Vec3 &a = a_[i], &b = b_[i], &da = da_[i], &db = db_[i];
+  for (int it = 0; it < 5; ++it) {
+    double tt = t * t;
+    Vec3 c = point(i, t) - p;
+    Vec3 d1 = a * (6 * tt - 6 * t) + da * (3 * tt - 4 * t + 1) + b * (6 * t - 6 * tt) + db * (3 * tt - 2 * t);
+    Vec3 d2 = a * (12 * t - 6) + da * (6 * t - 4) + b * (6 - 12 * t) + db * (6 * t - 2);
+    double g = c | d1, hess = (d1 | d1) + (c | d2);
+    if (hess <= 0) hess = d1 | d1;
+    if (hess <= 0) break;
+    double next = std::clamp(t - g / hess, 0.0, 1.0);
+    if (std::abs(next - t) < 1e-14) break;
+    t = next;
+  }
+  return point(i, t);
 }
 
 void ReferencePolyline::ensure_tree() const {
@@ -218,6 +301,11 @@ void ReferencePolyline::ensure_tree() const {
     lo[i].minimize(b_[i]);
     hi[i] = a_[i];
     hi[i].maximize(b_[i]);
+    if (smooth_[i])  // the arc lies in the hull of its Bézier control points
+      for (const Vec3& q : {a_[i] + da_[i] / 3.0, b_[i] - db_[i] / 3.0}) {
+        lo[i].minimize(q);
+        hi[i].maximize(q);
+      }
   }
   tree_.build(lo, hi);
   built_ = true;
@@ -229,7 +317,7 @@ Vec3 ReferencePolyline::closest(const Vec3& p, int label) const {
   Vec3 best = p;
   detail::nearest(tree_, p, best2, [&](int i) {
     if (label_[i] != label) return;
-    Vec3 q = closest_point_on_segment(p, a_[i], b_[i]);
+    Vec3 q = closest_on(std::size_t(i), p);
     double d2 = (q - p).sqrnorm();
     if (d2 < best2) {
       best2 = d2;

@@ -236,6 +236,10 @@ void Remesher::classify_features() {
       curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), c);
     }
   }
+  // The interface samples a smooth curve: split midpoints and relocated vertices go onto a C¹ curve
+  // through its vertices, not onto its chords (which would shrink convex regions at every remesh).
+  // Ridges and boundaries are real polylines and stay so.
+  curves_.smooth(kInterfaceCurve, corner_angle_);
 }
 
 void Remesher::compute_sizing() {

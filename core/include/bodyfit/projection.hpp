@@ -67,10 +67,25 @@ class ReferencePolyline {
   /// Closest point to p on the segments with `label`; returns p when there is none.
   Vec3 closest(const Vec3& p, int label) const;
   std::size_t size() const { return a_.size(); }
+  /// Replace the chords carrying `label` by a C¹ curve through the same vertices, so that points
+  /// put on the curve (split midpoints, relocated vertices) stay on the smooth curve the polyline
+  /// samples instead of falling inside it by the sagitta. Each segment becomes a cubic Hermite arc
+  /// whose end tangents come from the neighbouring segment (Bessel's three-point tangent, exact to
+  /// second order) where exactly two segments of `label` meet at a turning angle ≤ `corner_angle`
+  /// (radians); at ends, corners and junctions the tangent is one-sided (the other end's tangent
+  /// mirrored about the chord, or the chord itself). Vertices are matched by exact coordinates.
+  /// Call after the last add() of that label.
+  void smooth(int label, double corner_angle);
+  /// Point at parameter t ∈ [0, 1] of segment i (on its Hermite arc when smoothed, else its chord).
+  Vec3 point(std::size_t i, double t) const;
 
  private:
   void ensure_tree() const;
+  /// Closest point to p on segment i (its arc when smoothed, else its chord).
+  Vec3 closest_on(std::size_t i, const Vec3& p) const;
   std::vector<Vec3> a_, b_;
+  std::vector<Vec3> da_, db_;  ///< Hermite end derivatives d/dt at a and b (chord b − a when not smoothed)
+  std::vector<char> smooth_;
   std::vector<int> label_;
   mutable bool built_ = false;
   mutable detail::BoxTree tree_;
