@@ -44,21 +44,9 @@ std::vector<double> parse_list(const char* text) {
 
 /// E of (4.5) with the edge-midpoint rule on each flat triangle.
 double cap_error(const SurfaceMesh& mesh, const ScalarField& d, double final_angle) {
-  double sum = 0;
-  for (auto f : mesh.faces()) {
-    std::array<VertexHandle, 3> v;
-    int k = 0;
-    for (auto vh : mesh.fv_range(f)) v[k++] = vh;
-    const double area = face_area(mesh, f);
-    for (int i = 0; i < 3; ++i) {
-      auto a = v[i], b = v[(i + 1) % 3];
-      Vec3 m = 0.5 * (mesh.point(a) + mesh.point(b));
-      double beta = std::acos(std::clamp(m[2] / m.norm(), -1.0, 1.0));
-      double diff = 0.5 * (d[a.idx()] + d[b.idx()]) - (beta - final_angle);
-      sum += area / 3 * diff * diff;
-    }
-  }
-  return std::sqrt(sum);
+  return l2_difference(mesh, d, [&](const Vec3& m) {
+    return std::acos(std::clamp(m[2] / m.norm(), -1.0, 1.0)) - final_angle;
+  });
 }
 
 struct Row {

@@ -1,6 +1,8 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -56,4 +58,17 @@ TEST_CASE("area of the inscribed geodesic sphere converges at order 2") {
     if (previous > 0) CHECK(std::log2(previous / deficit) == doctest::Approx(2.0).epsilon(0.05));
     previous = deficit;
   }
+}
+
+TEST_CASE("l2_difference integrates squared P1 differences exactly (midpoint rule is exact for quadratics)") {
+  SurfaceMesh square = test::grid_square(7);
+  ScalarField zero(square.n_vertices(), 0.0);
+  // Over [0,1]²: ∫ x² = 1/3; ∫ (x + 2y)² = 1/3 + ∫ 4xy + ∫ 4y² = 1/3 + 1 + 4/3 = 8/3.
+  CHECK(l2_difference(square, zero, [](const Vec3& p) { return p[0]; }) == doctest::Approx(std::sqrt(1.0 / 3)).epsilon(1e-13));
+  CHECK(l2_difference(square, zero, [](const Vec3& p) { return p[0] + 2 * p[1]; }) ==
+        doctest::Approx(std::sqrt(8.0 / 3)).epsilon(1e-13));
+  // A P1 field equal to the exact affine function has no error.
+  ScalarField affine(square.n_vertices());
+  for (auto v : square.vertices()) affine[v.idx()] = 3 * square.point(v)[0] - square.point(v)[1];
+  CHECK(l2_difference(square, affine, [](const Vec3& p) { return 3 * p[0] - p[1]; }) == doctest::Approx(0.0).epsilon(1e-14));
 }

@@ -185,6 +185,20 @@ double interface_length(const SurfaceMesh& mesh) {
   return length;
 }
 
+double l2_difference(const SurfaceMesh& mesh, const ScalarField& u_h, const std::function<double(const Vec3&)>& u) {
+  double sum = 0;
+  for (auto f : mesh.faces()) {
+    const auto v = face_vertices(mesh, f);
+    const double area = face_area(mesh, f);
+    for (int i = 0; i < 3; ++i) {
+      const auto a = v[i], b = v[(i + 1) % 3];
+      const double diff = 0.5 * (u_h[a.idx()] + u_h[b.idx()]) - u(0.5 * (mesh.point(a) + mesh.point(b)));
+      sum += area / 3 * diff * diff;
+    }
+  }
+  return std::sqrt(sum);
+}
+
 long euler_characteristic(const SurfaceMesh& mesh) {
   auto count = [](auto range) {
     long n = 0;

@@ -4,6 +4,7 @@
 #include <bodyfit/mesh.hpp>
 
 #include <array>
+#include <functional>
 #include <vector>
 
 namespace bodyfit {
@@ -65,6 +66,10 @@ double total_area(const SurfaceMesh& mesh);
 double region_area(const SurfaceMesh& mesh, int region);
 /// Total length of the edges tagged as interface.
 double interface_length(const SurfaceMesh& mesh);
+
+/// (∫_S (u_h − u)²)^½ for a P1 field u_h and an exact function u, with the edge-midpoint rule on
+/// each flat triangle (exact for quadratics): the error measure E of the paper's (4.5).
+double l2_difference(const SurfaceMesh& mesh, const ScalarField& u_h, const std::function<double(const Vec3&)>& u);
 
 // ---- topology ----------------------------------------------------------------------------------
 
