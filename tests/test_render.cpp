@@ -146,3 +146,26 @@ TEST_CASE("bodyfit render: CLI writes the PNG at --size") {
   CHECK(r.exit_code == 1);
   CHECK(r.output.find("--size '30'") != std::string::npos);
 }
+
+TEST_CASE("the top view is a map: x (east) to the right, y (north) up") {
+  SurfaceMesh plane = test::grid_square(20);  // [0, 1]², z = 0
+  for (auto f : plane.faces()) {
+    Vec3 c(0, 0, 0);
+    for (auto v : plane.fv_range(f)) c += plane.point(v) / 3;
+    plane.region(f) = c[0] > 0.5 && c[1] > 0.5 ? kInside : kOutside;  // the north-east quarter
+  }
+  update_interface_from_regions(plane);
+  RenderOptions options;
+  options.width = options.height = 200;
+  options.draw_interface = false;
+  set_view(options, "top");
+  Image image = render(plane, options);
+  auto is_inside = [&](int x, int y) {
+    Rgb p = image.at(x, y);
+    return p[0] > p[2];  // the inside colour is red-dominant, the outside blue-dominant
+  };
+  CHECK(is_inside(150, 50));    // upper right: north-east
+  CHECK(!is_inside(50, 50));    // upper left: north-west
+  CHECK(!is_inside(150, 150));  // lower right: south-east
+  CHECK(!is_inside(50, 150));   // lower left: south-west
+}

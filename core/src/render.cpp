@@ -218,7 +218,7 @@ Rgb colormap(double s) {
 
 void set_view(RenderOptions& options, const std::string& view) {
   if (view == "iso") options.azimuth = -60, options.elevation = 30;
-  else if (view == "top") options.azimuth = -90, options.elevation = 90;
+  else if (view == "top") options.azimuth = 0, options.elevation = 90;  // map view: x right, y (north) up
   else if (view == "front") options.azimuth = -90, options.elevation = 0;
   else throw InputError(fmt::format("unknown view '{}' (iso, top or front)", view));
 }
