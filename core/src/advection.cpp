@@ -8,9 +8,9 @@
 // walk continues there. A path that reaches a vertex or runs along an edge is handled by the same
 // rule (a zero-length step crosses to the next face), so no characteristic is ever dropped.
 //
-// Tangent vectors are moved between faces by the composed unfolding rotations: RK4 carries each
-// stage's velocity back to the start face (the transpose), RK2 carries V(x) forward to the midpoint
-// and continues walking from there.
+// Tangent vectors are moved between faces by the same unfoldings: RK4 carries each stage's
+// velocity back to the start face along the crossed edges; RK2 carries its first half-step forward
+// to the midpoint (the walk returns the displacement carried) and continues walking from there.
 //
 // Faces are stored, and vertices traced, in Z-order so that neighbouring characteristics read
 // neighbouring memory; each trace is independent, so the result does not depend on the threads.
@@ -28,76 +28,60 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 
 namespace bodyfit {
 namespace {
 
-// ---- small fixed-size algebra (no allocation, fully inlined) -----------------------------------
-
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
-inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
-inline double norm(V3 a) { return std::sqrt(dot(a, a)); }
-inline V3 from(const Vec3& p) { return {p[0], p[1], p[2]}; }
-
-/// Row-major 3×3 rotation.
-struct M3 {
-  double m[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  V3 apply(V3 v) const {
-    return {m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z,
-            m[6] * v.x + m[7] * v.y + m[8] * v.z};
-  }
-  V3 apply_transposed(V3 v) const {
-    return {m[0] * v.x + m[3] * v.y + m[6] * v.z, m[1] * v.x + m[4] * v.y + m[7] * v.z,
-            m[2] * v.x + m[5] * v.y + m[8] * v.z};
-  }
-};
-
-/// Rotation taking the orthonormal frame (e, a1, n1) to (e, a2, n2): R = Σ out_k ⊗ in_k, applied
-/// on the left of the accumulated rotation (R ← R_new · R).
-inline void compose_unfolding(M3& r, V3 e, V3 a1, V3 n1, V3 a2, V3 n2) {
-  const double rn[9] = {e.x * e.x + a2.x * a1.x + n2.x * n1.x, e.x * e.y + a2.x * a1.y + n2.x * n1.y,
-                        e.x * e.z + a2.x * a1.z + n2.x * n1.z, e.y * e.x + a2.y * a1.x + n2.y * n1.x,
-                        e.y * e.y + a2.y * a1.y + n2.y * n1.y, e.y * e.z + a2.y * a1.z + n2.y * n1.z,
-                        e.z * e.x + a2.z * a1.x + n2.z * n1.x, e.z * e.y + a2.z * a1.y + n2.z * n1.y,
-                        e.z * e.z + a2.z * a1.z + n2.z * n1.z};
-  M3 out;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      out.m[3 * i + j] = rn[3 * i] * r.m[j] + rn[3 * i + 1] * r.m[3 + j] + rn[3 * i + 2] * r.m[6 + j];
-  r = out;
-}
-
 // ---- flat per-face data, built once per call ---------------------------------------------------
 
-// The walk is bound by memory latency (each crossing loads the next face, each velocity evaluation
-// its corners), so the record holds what the walk and the velocity evaluation read, and nothing
-// else: three cache lines. The vertex indices, read once per characteristic, are kept apart.
+// The walk never leaves barycentric coordinates. A displacement inside a face is its increment of
+// the three coordinates (Σ = 0); crossing an edge maps that increment linearly into the neighbour's
+// coordinates through the unfolding about the edge, a map fixed by two numbers per edge: the
+// coordinates, in this face, of the neighbour's far corner unfolded into this face's plane. A
+// crossing is then a division, a few multiply-adds and one load of the next face's record, which
+// fits one cache line. Velocities are stored the same way (the increment per unit time at each
+// corner, in each incident face), so a sub-step needs no 3-D geometry at all.
 struct alignas(64) Face {
-  // What the walk reads comes first (the first 140 bytes), the corner velocities last.
-  V3 grad[3];          ///< gradients of the P1 basis functions (in the face's plane)
-  V3 normal;           ///< unit normal
-  double altitude[3];  ///< 1/|∇λ_i|: the unfolding needs unit directions, without a square root
-  int neighbour[3];    ///< face across the edge opposite corner i, −1 on the boundary
+  /// 1/α, α < 0 the coordinate for corner i of the neighbour's far corner unfolded across the edge
+  /// opposite corner i.
+  double unfold_far[3];
+  /// The coordinate for corner (i + 1) % 3 of that unfolded far corner.
+  double unfold_next[3];
+  int neighbour[3];  ///< face across the edge opposite corner i, −1 on the boundary
   /// In the neighbour across edge i: bits 0–1 the slot of the corner opposite that edge, bits 2–3
   /// the slot of this face's corner (i + 1) % 3 (the third slot holds corner (i + 2) % 3).
   unsigned char across[3];
-  float size;        ///< mean edge length: sets the sub-step
-  V3 velocity[3];    ///< V at the corners, projected on the face's plane (V is P1: project, then interpolate)
 };
-static_assert(sizeof(Face) == 256);  // 211 bytes of data
+static_assert(sizeof(Face) == 64);
 
+/// What a velocity evaluation reads: V at the corners as coordinate increments per unit time, and
+/// the squared edge lengths (in units of the face's mean edge length) that give a speed in cells
+/// per unit time: |d|² = −(d₁d₂ℓ₀² + d₀d₂ℓ₁² + d₀d₁ℓ₂²) for an increment d (Σ dᵢ = 0).
+struct FaceMotion {
+  double rate[3][3];     ///< rate[j] = increment per unit time of V at corner j
+  double edge2[3];       ///< (ℓ_k / mean edge length)², ℓ_k the edge opposite corner k
+};
+
+/// Coordinate increments of a tangent displacement (the three add up to zero).
+struct Delta {
+  double d[3] = {0, 0, 0};
+};
+inline Delta operator*(double s, const Delta& a) { return {{s * a.d[0], s * a.d[1], s * a.d[2]}}; }
+inline Delta operator+(const Delta& a, const Delta& b) {
+  return {{a.d[0] + b.d[0], a.d[1] + b.d[1], a.d[2] + b.d[2]}};
+}
+inline Delta operator-(const Delta& a, const Delta& b) {
+  return {{a.d[0] - b.d[0], a.d[1] - b.d[1], a.d[2] - b.d[2]}};
+}
 
 struct Surface {
   std::vector<Face> faces;
+  std::vector<FaceMotion> motion;
   std::vector<std::array<int, 3>> corners;  ///< vertex indices of each face
+  std::vector<Vec3> points;                 ///< vertex positions
   std::vector<int> vertex_face;          ///< one face incident to each vertex
   std::vector<signed char> vertex_slot;  ///< the vertex's corner slot in that face
   std::vector<int> vertex_order;         ///< vertices in Z-order: neighbours trace through the same faces
@@ -114,19 +98,24 @@ std::uint64_t spread_bits(std::uint64_t x) {
   return x;
 }
 
-/// Indices 0..n−1 sorted by the Z-order (Morton) code of point(i) in the box, ties by index, so the
-/// order is deterministic. Walks from neighbouring vertices then touch neighbouring memory.
-template <class PointOf>
-std::vector<int> z_order(int n, const BoundingBox& box, PointOf point_of) {
+/// Vertex indices sorted by the Z-order (Morton) code of their points, ties by index, so the order
+/// is deterministic. Walks from neighbouring vertices then touch neighbouring memory.
+std::vector<int> z_order(const std::vector<Vec3>& points) {
+  BoundingBox box;
+  if (!points.empty()) box.min = box.max = points[0];
+  for (const Vec3& p : points) {
+    box.min.minimize(p);
+    box.max.maximize(p);
+  }
   const Vec3 extent = box.max - box.min;
   const double scale = double((1 << 21) - 1);
+  const int n = int(points.size());
   std::vector<std::pair<std::uint64_t, int>> keyed(n);
   tbb::parallel_for(tbb::blocked_range<int>(0, n, 8192), [&](const tbb::blocked_range<int>& range) {
     for (int i = range.begin(); i != range.end(); ++i) {
-      const Vec3 p = point_of(i);
       std::uint64_t code = 0;
       for (int c = 0; c < 3; ++c) {
-        const double t = extent[c] > 0 ? (p[c] - box.min[c]) / extent[c] : 0.0;
+        const double t = extent[c] > 0 ? (points[i][c] - box.min[c]) / extent[c] : 0.0;
         code |= spread_bits(std::uint64_t(std::clamp(t, 0.0, 1.0) * scale)) << c;
       }
       keyed[i] = {code, i};
@@ -142,80 +131,97 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
   Surface s;
   const int nf = int(mesh.n_faces());
   const int nv = int(mesh.n_vertices());
-  s.faces.resize(nf);
-  s.corners.resize(nf);
-  s.vertex_face.assign(nv, -1);
-  s.vertex_slot.assign(nv, 0);
-  // Faces are stored in Z-order of their centroids: a walk's next face is usually close in memory.
-  const BoundingBox box = bounding_box(mesh);
-  const std::vector<int> face_order = z_order(nf, box, [&](int fi) {
-    Vec3 c(0, 0, 0);
-    for (auto v : mesh.fv_range(FaceHandle(fi))) c += mesh.point(v);
-    return c / 3.0;
-  });
-  std::vector<int> slot_of(nf);
-  for (int i = 0; i < nf; ++i) slot_of[face_order[i]] = i;
-  s.vertex_order = z_order(nv, box, [&](int vi) { return mesh.point(VertexHandle(vi)); });
+  s.points.resize(nv);
+  for (int v = 0; v < nv; ++v) s.points[v] = mesh.point(VertexHandle(v));
+  // Connectivity as flat arrays, read once from the halfedges: corner i of a face is the target of
+  // its halfedge h_i, and the edge opposite corner i is that of h_{i+2}.
+  std::vector<std::array<int, 3>> corners(nf), across(nf);
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& range) {
     for (int fi = range.begin(); fi != range.end(); ++fi) {
-      const FaceHandle fh(fi);
-      Face& f = s.faces[slot_of[fi]];
-      std::array<int, 3>& corner = s.corners[slot_of[fi]];
-      V3 p[3];
-      // Corner i is the target of halfedge h_i; the edge opposite corner i is that of h_{i+1}.
-      HalfedgeHandle h[3];
-      h[0] = mesh.halfedge_handle(fh);
-      h[1] = mesh.next_halfedge_handle(h[0]);
-      h[2] = mesh.next_halfedge_handle(h[1]);
+      HalfedgeHandle h = mesh.halfedge_handle(FaceHandle(fi));
       for (int i = 0; i < 3; ++i) {
-        const VertexHandle v = mesh.to_vertex_handle(h[i]);
-        corner[i] = v.idx();
-        p[i] = from(mesh.point(v));
-      }
-      const auto g = p1_basis_gradients(mesh.point(VertexHandle(corner[0])), mesh.point(VertexHandle(corner[1])),
-                                        mesh.point(VertexHandle(corner[2])));
-      for (int i = 0; i < 3; ++i) {
-        f.grad[i] = from(g[i]);
-        const double len = norm(f.grad[i]);
-        f.altitude[i] = len > 0 ? 1.0 / len : 0.0;
-      }
-      V3 n = cross(p[1] - p[0], p[2] - p[0]);
-      const double nn = norm(n);
-      const V3 normal = f.normal = nn > 0 ? (1.0 / nn) * n : V3{};
-      for (int i = 0; i < 3; ++i) {
-        const V3 v = from(velocity[corner[i]]);
-        f.velocity[i] = v - dot(v, normal) * normal;
-      }
-      f.size = float((norm(p[1] - p[0]) + norm(p[2] - p[1]) + norm(p[0] - p[2])) / 3.0);
-      for (int i = 0; i < 3; ++i) {
-        // Edge opposite corner i joins corners i+1 and i+2: halfedge h_{i+2} runs from i+1 to i+2.
-        const HalfedgeHandle opposite = mesh.opposite_halfedge_handle(h[(i + 2) % 3]);
-        f.neighbour[i] = -1;
-        f.across[i] = 0;
-        if (mesh.is_boundary(opposite)) continue;
-        const FaceHandle gh = mesh.face_handle(opposite);
-        f.neighbour[i] = slot_of[gh.idx()];
-        // Slots in g: the corner opposite the shared edge is next(opposite)'s target.
-        HalfedgeHandle gh0 = mesh.halfedge_handle(gh);
-        HalfedgeHandle gh_[3] = {gh0, mesh.next_halfedge_handle(gh0), HalfedgeHandle()};
-        gh_[2] = mesh.next_halfedge_handle(gh_[1]);
-        const int far = mesh.to_vertex_handle(mesh.next_halfedge_handle(opposite)).idx();
-        int slot_far = 0, slot_next = 0;
-        for (int j = 0; j < 3; ++j) {
-          const int vj = mesh.to_vertex_handle(gh_[j]).idx();
-          if (vj == far) slot_far = j;
-          if (vj == corner[(i + 1) % 3]) slot_next = j;
-        }
-        f.across[i] = static_cast<unsigned char>(slot_far | (slot_next << 2));
+        corners[fi][i] = mesh.to_vertex_handle(h).idx();
+        const HalfedgeHandle o = mesh.opposite_halfedge_handle(h);
+        across[fi][(i + 1) % 3] = mesh.is_boundary(o) ? -1 : mesh.face_handle(o).idx();
+        h = mesh.next_halfedge_handle(h);
       }
     }
   });
-  // One incident face per vertex, chosen deterministically (smallest face index).
+  // Vertices in Z-order, faces in the order of their first corner in it (a counting sort): a walk's
+  // next face is then usually close in memory, and so are the faces of neighbouring vertices.
+  s.vertex_order = z_order(s.points);
+  std::vector<int> rank(nv);
+  for (int k = 0; k < nv; ++k) rank[s.vertex_order[k]] = k;
+  std::vector<int> start(std::size_t(nv) + 1, 0);
   for (int fi = 0; fi < nf; ++fi)
+    ++start[1 + std::min({rank[corners[fi][0]], rank[corners[fi][1]], rank[corners[fi][2]]})];
+  for (int k = 0; k < nv; ++k) start[k + 1] += start[k];
+  std::vector<int> slot_of(nf), face_order(nf);
+  for (int fi = 0; fi < nf; ++fi) {
+    const int key = std::min({rank[corners[fi][0]], rank[corners[fi][1]], rank[corners[fi][2]]});
+    slot_of[fi] = start[key]++;
+    face_order[slot_of[fi]] = fi;
+  }
+  s.faces.resize(nf);
+  s.motion.resize(nf);
+  s.corners.resize(nf);
+  tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& range) {
+    for (int slot = range.begin(); slot != range.end(); ++slot) {
+      const int fi = face_order[slot];
+      Face& f = s.faces[slot];
+      FaceMotion& m = s.motion[slot];
+      const std::array<int, 3>& corner = s.corners[slot] = corners[fi];
+      const Vec3 p[3] = {s.points[corner[0]], s.points[corner[1]], s.points[corner[2]]};
+      const auto grad = p1_basis_gradients(p[0], p[1], p[2]);
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) m.rate[j][i] = OpenMesh::dot(grad[i], velocity[corner[j]]);
+      double mean = 0;
+      for (int k = 0; k < 3; ++k) mean += (p[(k + 2) % 3] - p[(k + 1) % 3]).norm() / 3.0;
+      for (int k = 0; k < 3; ++k) m.edge2[k] = mean > 0 ? (p[(k + 2) % 3] - p[(k + 1) % 3]).sqrnorm() / (mean * mean) : 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+        f.neighbour[i] = -1;
+        f.across[i] = 0;
+        f.unfold_far[i] = 0;
+        f.unfold_next[i] = 0;
+        const int g = across[fi][i];
+        if (g < 0) continue;
+        // Slots in g: the corner that is not on the shared edge, and this face's corner i + 1.
+        int slot_far = 0, slot_next = 0;
+        for (int j = 0; j < 3; ++j) {
+          const int vj = corners[g][j];
+          if (vj != corner[i1] && vj != corner[i2]) slot_far = j;
+          if (vj == corner[i1]) slot_next = j;
+        }
+        // Unfold the far corner q into this face's plane: keep its offset along the edge and its
+        // distance from the edge line, turned to point out of this face (−∇λ_i).
+        const Vec3 q = s.points[corners[g][slot_far]];
+        Vec3 e = p[i2] - p[i1];
+        const double len = e.norm();
+        const double gi = grad[i].norm();
+        if (len == 0 || gi == 0) continue;  // degenerate: leave the edge closed
+        e /= len;
+        const Vec3 rel = q - p[i1];
+        const double along = OpenMesh::dot(rel, e);
+        const double away = (rel - along * e).norm();
+        const double alpha = -away * gi;  // λ_i at the unfolded corner
+        if (!(alpha < 0)) continue;       // the neighbour is degenerate: leave the edge closed
+        const Vec3 unfolded_rel = along * e - (away / gi) * grad[i];
+        f.neighbour[i] = slot_of[g];
+        f.across[i] = static_cast<unsigned char>(slot_far | (slot_next << 2));
+        f.unfold_far[i] = 1.0 / alpha;
+        f.unfold_next[i] = 1.0 + OpenMesh::dot(grad[i1], unfolded_rel);
+      }
+    }
+  });
+  // One incident face per vertex, chosen deterministically (the first in storage order).
+  s.vertex_face.assign(nv, -1);
+  s.vertex_slot.assign(nv, 0);
+  for (int slot = 0; slot < nf; ++slot)
     for (int i = 0; i < 3; ++i) {
-      const int v = s.corners[fi][i];
+      const int v = s.corners[slot][i];
       if (s.vertex_face[v] < 0) {
-        s.vertex_face[v] = fi;
+        s.vertex_face[v] = slot;
         s.vertex_slot[v] = static_cast<signed char>(i);
       }
     }
@@ -236,14 +242,31 @@ enum class WalkEnd { arrived, boundary, stalled };
 /// turning around a vertex takes at most its valence in zero-length crossings).
 constexpr int kMaxCrossings = 4096;
 
-/// Move `at` by the tangent displacement d (expressed in the plane of at.face). When `rotation` is
-/// given, the unfolding rotations of the crossed edges are composed into it.
-WalkEnd walk(const Surface& s, Location& at, V3 d, M3* rotation) {
-  // d need not be projected on the face's plane: the basis gradients ignore its normal part and the
-  // unfolding rotations carry that part along as a normal part.
+/// The increment d of face f carried across its edge opposite corner `exit` into the neighbour's
+/// coordinates (the unfolding is an isometry, so this is the same displacement).
+inline Delta carry(const Face& f, int exit, const Delta& d) {
+  const int jo = f.across[exit] & 3, jn = f.across[exit] >> 2;
+  Delta out;
+  out.d[jo] = d.d[exit] * f.unfold_far[exit];
+  out.d[jn] = d.d[(exit + 1) % 3] - f.unfold_next[exit] * out.d[jo];
+  out.d[3 - jo - jn] = -(out.d[jo] + out.d[jn]);  // keeps Σ = 0 exactly
+  return out;
+}
+
+/// One edge crossed by a walk: the face entered and the slot, in it, of the corner opposite the
+/// edge; enough to carry an increment back (RK4 stages).
+struct Crossed {
+  int face;
+  int far_slot;
+};
+
+/// Move `at` by the displacement d (coordinate increments in at.face). On return d is the whole
+/// displacement carried into the face reached. When `path` is given, the crossed edges are
+/// appended to it.
+WalkEnd walk(const Surface& s, Location& at, Delta& d, std::vector<Crossed>* path) {
+  double rest = 1.0;  // fraction of d still to walk
   for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
-    const Face& f = s.faces[at.face];
-    const double db[3] = {dot(f.grad[0], d), dot(f.grad[1], d), dot(f.grad[2], d)};
+    const double db[3] = {rest * d.d[0], rest * d.d[1], rest * d.d[2]};
     // Coordinates reaching zero before the end of the displacement (b_i + db_i < 0). Most calls
     // end in the face they start in, and this test needs no division. An overshoot below the
     // rounding level is not a crossing: a path running along an edge (a boundary edge in
@@ -254,6 +277,7 @@ WalkEnd walk(const Surface& s, Location& at, V3 d, M3* rotation) {
       for (int i = 0; i < 3; ++i) at.b[i] = std::max(at.b[i] + db[i], 0.0);
       return WalkEnd::arrived;
     }
+    const Face& f = s.faces[at.face];
     // First edge reached: the smallest t with b_i + t db_i = 0.
     int exit = -1;
     double t_exit = 1.0;
@@ -273,36 +297,35 @@ WalkEnd walk(const Surface& s, Location& at, V3 d, M3* rotation) {
     }
     double b[3];
     for (int i = 0; i < 3; ++i) b[i] = i == exit ? 0.0 : std::max(at.b[i] + t_exit * db[i], 0.0);
-    const int i1 = (exit + 1) % 3, i2 = (exit + 2) % 3;
     const int g = f.neighbour[exit];
     if (g < 0) {  // leaves the surface: stop on the boundary edge
       for (int i = 0; i < 3; ++i) at.b[i] = b[i];
       return WalkEnd::boundary;
     }
-    d = (1.0 - t_exit) * d;
-    const Face& fg = s.faces[g];
-    // Unfold about the shared edge: the frame (e, u1, n1) of f maps to (e, u2, n2) of g, where u1 is
-    // the unit direction leaving f across the edge (−∇λ_exit normalised) and u2 the one entering g
-    // (∇λ of g's corner opposite the edge, normalised); e = u1 × n1 is the edge direction.
+    rest *= 1.0 - t_exit;
+    d = carry(f, exit, d);
     const int jo = f.across[exit] & 3, jn = f.across[exit] >> 2;
-    const V3 n1 = f.normal, n2 = fg.normal;
-    const V3 u1 = (-f.altitude[exit]) * f.grad[exit];
-    const V3 u2 = fg.altitude[jo] * fg.grad[jo];
-    const V3 e = cross(u1, n1);
-    d = dot(d, e) * e + dot(d, u1) * u2 + dot(d, n1) * n2;
-    if (rotation) compose_unfolding(*rotation, e, u1, n1, u2, n2);
+    if (path) path->push_back({g, jo});
     at.face = g;
     at.b[jo] = 0.0;
-    at.b[jn] = b[i1];
-    at.b[3 - jo - jn] = b[i2];
+    at.b[jn] = b[(exit + 1) % 3];
+    at.b[3 - jo - jn] = b[(exit + 2) % 3];
   }
   return WalkEnd::stalled;
 }
 
-/// V at a location, projected onto the face's plane.
-inline V3 velocity_at(const Surface& s, const Location& at) {
-  const Face& f = s.faces[at.face];
-  return at.b[0] * f.velocity[0] + at.b[1] * f.velocity[1] + at.b[2] * f.velocity[2];
+/// V at a location, as coordinate increments per unit time in its face.
+inline Delta velocity_at(const Surface& s, const Location& at) {
+  const FaceMotion& m = s.motion[at.face];
+  Delta v;
+  for (int i = 0; i < 3; ++i) v.d[i] = at.b[0] * m.rate[0][i] + at.b[1] * m.rate[1][i] + at.b[2] * m.rate[2][i];
+  return v;
+}
+
+/// Squared length of an increment of face f, in units of its mean edge length.
+inline double cells2(const Surface& s, int face, const Delta& v) {
+  const FaceMotion& m = s.motion[face];
+  return std::max(0.0, -(v.d[1] * v.d[2] * m.edge2[0] + v.d[0] * v.d[2] * m.edge2[1] + v.d[0] * v.d[1] * m.edge2[2]));
 }
 
 struct TraceResult {
@@ -313,57 +336,56 @@ struct TraceResult {
 };
 
 /// Trace the characteristic through `start` backwards over a time T.
-TraceResult trace(const Surface& s, Location start, double T,
-                  const AdvectionOptions& opt) {
+TraceResult trace(const Surface& s, Location start, double T, const AdvectionOptions& opt,
+                  std::vector<Crossed>& path) {
   TraceResult r;
   Location x = start;
   const int outer = std::max(1, opt.steps);
   const double outer_dt = T / outer;
-  auto stage = [&](const Location& from, V3 d, V3& k) -> bool {
-    // V at the point reached from `from` by walking d, carried back into from's plane.
+  auto stage = [&](const Location& from, Delta d, Delta& k) -> bool {
+    // V at the point reached from `from` by walking d, carried back into from's face along the
+    // same edges in reverse (each crossing undone by the entered face's own map).
     Location y = from;
-    M3 rot;
-    if (walk(s, y, d, &rot) == WalkEnd::stalled) return false;
-    k = rot.apply_transposed(velocity_at(s, y));
+    path.clear();
+    if (walk(s, y, d, &path) == WalkEnd::stalled) return false;
+    k = velocity_at(s, y);
+    for (auto c = path.rbegin(); c != path.rend(); ++c) k = carry(s.faces[c->face], c->far_slot, k);
     return true;
   };
+  const double cells = opt.max_cells_per_substep;
   for (int o = 0; o < outer; ++o) {
     double remaining = outer_dt;
     double dt = 0;  // kept from one sub-step to the next while it still fits (no square root, no division)
     while (remaining > 0) {
-      const V3 k1 = velocity_at(s, x);
-      const double speed2 = dot(k1, k1);
-      const double reach = opt.max_cells_per_substep * s.faces[x.face].size;
-      if (dt == 0 || speed2 * dt * dt > 1.5625 * reach * reach) {  // (1.25 reach)²
-        // Equal sub-steps over what remains, each crossing about `reach`.
-        dt = speed2 * remaining * remaining > reach * reach ? remaining / std::ceil(std::sqrt(speed2) * remaining / reach)
+      const Delta k1 = velocity_at(s, x);
+      const double speed2 = cells2(s, x.face, k1);  // in cells per unit time, squared
+      if (dt == 0 || speed2 * dt * dt > 1.5625 * cells * cells) {  // (1.25 cells)²
+        // Equal sub-steps over what remains, each crossing about `cells` cells.
+        dt = speed2 * remaining * remaining > cells * cells ? remaining / std::ceil(std::sqrt(speed2) * remaining / cells)
                                                             : remaining;
       }
       if (dt >= remaining * (1 - 1e-12)) dt = remaining;  // no sliver of a last step
       remaining = dt == remaining ? 0.0 : remaining - dt;
       ++r.substeps;
       if (opt.rk_order == 4) {
-        V3 k2, k3, k4;
+        Delta k2, k3, k4;
         if (!stage(x, (-0.5 * dt) * k1, k2) || !stage(x, (-0.5 * dt) * k2, k3) || !stage(x, (-dt) * k3, k4)) {
           r.stalled = true;
           break;
         }
-        const WalkEnd end = walk(s, x, (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4), nullptr);
+        Delta d = (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        const WalkEnd end = walk(s, x, d, nullptr);
         if (end != WalkEnd::arrived) {
           (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
           break;
         }
       } else {
-        // Midpoint rule, x ← x − dt·V(x − dt/2·V(x)). The walk goes on from the midpoint y rather
-        // than restarting from x: the remaining displacement, −dt·V(y) + dt/2·V(x), is expressed in
-        // y's face through the unfolding rotation of the first half. Where both walks would cross
-        // the same faces the end point is the same, and the walked length drops from 1.5 to 1.
-        M3 rotation;
-        WalkEnd end = walk(s, x, (-0.5 * dt) * k1, &rotation);
-        if (end == WalkEnd::arrived) {
-          const V3 k2 = velocity_at(s, x);
-          end = walk(s, x, (-dt) * k2 + (0.5 * dt) * rotation.apply(k1), nullptr);
-        }
+        // Midpoint rule, x ← x − dt·V(x − dt/2·V(x)), with V at the midpoint taken from the affine
+        // velocity of x's face (extended beyond it when the midpoint lies outside).
+        Location mid = x;
+        for (int i = 0; i < 3; ++i) mid.b[i] = x.b[i] - 0.5 * dt * k1.d[i];
+        Delta d = (-dt) * velocity_at(s, mid);
+        const WalkEnd end = walk(s, x, d, nullptr);
         if (end != WalkEnd::arrived) {
           (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
           break;
@@ -400,15 +422,12 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
   const int nv = int(mesh.n_vertices());
   ScalarField out(nv, 0.0);
   VectorField gradients;
-  std::vector<Vec3> points;
-  if (options.gradient_correction) {
-    gradients = vertex_gradients(mesh, phi);
-    points.resize(std::size_t(nv));
-    for (auto vh : mesh.vertices()) points[std::size_t(vh.idx())] = mesh.point(vh);
-  }
+  if (options.gradient_correction) gradients = vertex_gradients(mesh, phi);
+  const std::vector<Vec3>& points = s.points;
   std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0};
   tbb::parallel_for(tbb::blocked_range<int>(0, nv, 256), [&](const tbb::blocked_range<int>& range) {
     std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0;
+    std::vector<Crossed> path;  // scratch for RK4 stages
     for (int k = range.begin(); k != range.end(); ++k) {
       const int v = s.vertex_order[k];
       const int fi = s.vertex_face[v];
@@ -420,7 +439,7 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
       start.face = fi;
       start.b[0] = start.b[1] = start.b[2] = 0.0;
       start.b[s.vertex_slot[v]] = 1.0;
-      const TraceResult r = trace(s, start, T, options);
+      const TraceResult r = trace(s, start, T, options, path);
       const std::array<int, 3>& c = s.corners[r.foot.face];
       double value = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
       if (options.gradient_correction) {

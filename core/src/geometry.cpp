@@ -84,17 +84,35 @@ VectorField face_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
 }
 
 VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
-  VectorField fg = face_gradients(mesh, u);
-  VectorField result(mesh.n_vertices(), Vec3(0, 0, 0));
-  for (auto v : mesh.vertices()) {
-    Vec3 sum(0, 0, 0);
-    double weight = 0;
-    for (auto f : mesh.vf_range(v)) {
-      double area = face_area(mesh, f);
-      sum += area * fg[f.idx()];
-      weight += area;
+  // One pass over the faces, scattering to the corners: the area-weighted sum of the face
+  // gradients and the area-weighted normal (|cross| = 2·area weights both alike).
+  const std::size_t nv = mesh.n_vertices();
+  VectorField sum(nv, Vec3(0, 0, 0)), normal(nv, Vec3(0, 0, 0));
+  std::vector<double> weight(nv, 0.0);
+  for (auto f : mesh.faces()) {
+    auto h = mesh.halfedge_handle(f);
+    const VertexHandle v[3] = {mesh.to_vertex_handle(h), mesh.to_vertex_handle(mesh.next_halfedge_handle(h)),
+                               mesh.from_vertex_handle(h)};
+    const Vec3 &a = mesh.point(v[0]), &b = mesh.point(v[1]), &c = mesh.point(v[2]);
+    const Vec3 n = OpenMesh::cross(b - a, c - a);
+    const double twice_area_sq = n.sqrnorm();
+    if (twice_area_sq <= 0) continue;
+    // 2·area·∇u = n × (u_a (c − b) + u_b (a − c) + u_c (b − a)) / |n|.
+    const Vec3 weighted_gradient =
+        OpenMesh::cross(n, u[v[0].idx()] * (c - b) + u[v[1].idx()] * (a - c) + u[v[2].idx()] * (b - a)) /
+        std::sqrt(twice_area_sq);
+    const double twice_area = std::sqrt(twice_area_sq);
+    for (const VertexHandle& w : v) {
+      sum[w.idx()] += weighted_gradient;
+      normal[w.idx()] += n;
+      weight[w.idx()] += twice_area;
     }
-    if (weight > 0) result[v.idx()] = project_tangent(sum / weight, vertex_normal(mesh, v));
+  }
+  VectorField result(nv, Vec3(0, 0, 0));
+  for (std::size_t i = 0; i < nv; ++i) {
+    if (!(weight[i] > 0)) continue;
+    const double len = normal[i].norm();
+    result[i] = project_tangent(sum[i] / weight[i], len > 0 ? normal[i] / len : normal[i]);
   }
   return result;
 }
