@@ -1,11 +1,13 @@
 // Advection benchmark: φ0 = β − π/4 (β the polar angle) carried along the unit field e_β for
 // T = π/4 in one advect() call, on geodesic spheres of 2.4k to 620k faces; exact φ(T) = β − a − T
 // where β > T. Errors in the band |β − π/2| < 0.25.
-//   bench_advection [out.csv] [--rk 4] [--sizes 11,22,44]   (sizes are the sphere frequencies k, 20k² faces)
+//   bench_advection [out.csv] [--rk 4] [--cells C] [--repeat N] [--sizes 11,22,44]
+// (sizes are the sphere frequencies k, 20k² faces; times are medians over N calls, default 5)
 #include <bodyfit/advection.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -22,11 +24,14 @@ int main(int argc, char** argv) {
   std::string csv = "bench_advection.csv";
   AdvectionOptions options;
   std::vector<int> ks = {11, 22, 44, 88, 176};
+  int repeat = 5;  // timings are the median of this many calls (a shared machine is noisy)
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--rk") && i + 1 < argc) {
       options.rk_order = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--cells") && i + 1 < argc) {
       options.max_cells_per_substep = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) {
+      repeat = std::max(1, std::atoi(argv[++i]));
     } else if (!std::strcmp(argv[i], "--sizes") && i + 1 < argc) {
       ks.clear();
       std::stringstream list(argv[++i]);
@@ -57,16 +62,26 @@ int main(int argc, char** argv) {
       phi[v.idx()] = b - a;
       velocity[v.idx()] = Vec3(std::cos(al) * std::cos(b), std::sin(al) * std::cos(b), -std::sin(b));
     }
-    // The fixed cost (tables, Z-order, vertex gradients): the same call with T = 0.
-    const auto s0 = std::chrono::steady_clock::now();
-    (void)advect(mesh, phi, velocity, 0.0, options);
-    const double setup_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count();
+    // Each timing is the median over `repeat` calls; the fixed cost (tables, Z-order, vertex
+    // gradients) is that of the same call with T = 0.
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    std::vector<double> setup_runs, wall_runs, cpu_runs;
     AdvectionReport report;
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::clock_t c0 = std::clock();
-    const ScalarField result = advect(mesh, phi, velocity, T, options, &report);
-    const double cpu_ms = 1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC;  // all threads
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ScalarField result;
+    for (int r = 0; r < repeat; ++r) {
+      const auto s0 = std::chrono::steady_clock::now();
+      (void)advect(mesh, phi, velocity, 0.0, options);
+      setup_runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count());
+      const auto t0 = std::chrono::steady_clock::now();
+      const std::clock_t c0 = std::clock();
+      result = advect(mesh, phi, velocity, T, options, &report);
+      cpu_runs.push_back(1000.0 * double(std::clock() - c0) / CLOCKS_PER_SEC);  // all threads
+      wall_runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    const double setup_ms = median(setup_runs), ms = median(wall_runs), cpu_ms = median(cpu_runs);
 
     // Dual (barycentric) areas: a third of each incident face.
     std::vector<double> dual(nv, 0.0);

@@ -57,13 +57,15 @@ struct alignas(64) Face {
 };
 static_assert(sizeof(Face) == 64);
 
-/// What a velocity evaluation reads: V at the corners as coordinate increments per unit time, and
-/// the squared edge lengths (in units of the face's mean edge length) that give a speed in cells
-/// per unit time: |d|² = −(d₁d₂ℓ₀² + d₀d₂ℓ₁² + d₀d₁ℓ₂²) for an increment d (Σ dᵢ = 0).
-struct FaceMotion {
-  double rate[3][3];     ///< rate[j] = increment per unit time of V at corner j
-  double edge2[3];       ///< (ℓ_k / mean edge length)², ℓ_k the edge opposite corner k
+/// What a velocity evaluation reads, in one cache line: V at the corners as coordinate increments
+/// per unit time (the third increment is minus the sum of the first two), and the squared edge
+/// lengths in units of the face's mean edge length, which give a speed in cells per unit time:
+/// |d|² = −(d₁d₂ℓ₀² + d₀d₂ℓ₁² + d₀d₁ℓ₂²) for an increment d (Σ dᵢ = 0).
+struct alignas(64) FaceMotion {
+  double rate[3][2];  ///< rate[j] = first two increments per unit time of V at corner j
+  float edge2[3];     ///< (ℓ_k / mean edge length)², ℓ_k the edge opposite corner k (only sizes steps)
 };
+static_assert(sizeof(FaceMotion) == 64);
 
 /// Coordinate increments of a tangent displacement (the three add up to zero).
 struct Delta {
@@ -174,10 +176,11 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
       const Vec3 p[3] = {s.points[corner[0]], s.points[corner[1]], s.points[corner[2]]};
       const auto grad = p1_basis_gradients(p[0], p[1], p[2]);
       for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i) m.rate[j][i] = OpenMesh::dot(grad[i], velocity[corner[j]]);
+        for (int i = 0; i < 2; ++i) m.rate[j][i] = OpenMesh::dot(grad[i], velocity[corner[j]]);
       double mean = 0;
       for (int k = 0; k < 3; ++k) mean += (p[(k + 2) % 3] - p[(k + 1) % 3]).norm() / 3.0;
-      for (int k = 0; k < 3; ++k) m.edge2[k] = mean > 0 ? (p[(k + 2) % 3] - p[(k + 1) % 3]).sqrnorm() / (mean * mean) : 0.0;
+      for (int k = 0; k < 3; ++k)
+        m.edge2[k] = mean > 0 ? float((p[(k + 2) % 3] - p[(k + 1) % 3]).sqrnorm() / (mean * mean)) : 0.0f;
       for (int i = 0; i < 3; ++i) {
         const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
         f.neighbour[i] = -1;
@@ -260,30 +263,41 @@ struct Crossed {
   int far_slot;
 };
 
-/// Move `at` by the displacement d (coordinate increments in at.face). On return d is the whole
-/// displacement carried into the face reached. When `path` is given, the crossed edges are
-/// appended to it.
-WalkEnd walk(const Surface& s, Location& at, Delta& d, std::vector<Crossed>* path) {
-  double rest = 1.0;  // fraction of d still to walk
+/// a[i] for a variable i, by selects (the array stays in registers).
+inline double pick(const double (&a)[3], int i) { return i == 0 ? a[0] : i == 1 ? a[1] : a[2]; }
+
+/// Move `at` by the displacement d (coordinate increments in at.face). When `path` is given, the
+/// crossed edges are appended to it.
+///
+/// The walk follows the segment from the current point to the target point, both in the current
+/// face's coordinates (the target usually outside the face, some coordinates negative). At an
+/// edge, the target is mapped into the neighbour's coordinates by the unfolding (an affine map of
+/// two numbers), so the test "does the walk leave this face" only reads the target: the branch
+/// does not wait for the division that places the crossing point.
+[[gnu::always_inline]] inline WalkEnd walk(const Surface& s, Location& at, const Delta& d, std::vector<Crossed>* path) {
+  int face = at.face;
+  double b[3] = {at.b[0], at.b[1], at.b[2]};
+  double e[3] = {b[0] + d.d[0], b[1] + d.d[1], b[2] + d.d[2]};
   for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
-    const double db[3] = {rest * d.d[0], rest * d.d[1], rest * d.d[2]};
-    // Coordinates reaching zero before the end of the displacement (b_i + db_i < 0). Most calls
-    // end in the face they start in, and this test needs no division. An overshoot below the
-    // rounding level is not a crossing: a path running along an edge (a boundary edge in
-    // particular) stays on it instead of stepping out through rounding noise.
+    // An overshoot below the rounding level is not a crossing: a path running along an edge (a
+    // boundary edge in particular) stays on it instead of stepping out through rounding noise.
     constexpr double overshoot = -1e-13;
-    const bool reaches[3] = {at.b[0] + db[0] < overshoot, at.b[1] + db[1] < overshoot, at.b[2] + db[2] < overshoot};
-    if (!reaches[0] && !reaches[1] && !reaches[2]) {  // stays in this face
-      for (int i = 0; i < 3; ++i) at.b[i] = std::max(at.b[i] + db[i], 0.0);
+    const bool reaches[3] = {e[0] < overshoot, e[1] < overshoot, e[2] < overshoot};
+    if (!reaches[0] && !reaches[1] && !reaches[2]) {  // the target is in this face
+      at.face = face;
+      at.b[0] = e[0] > 0 ? e[0] : 0.0;
+      at.b[1] = e[1] > 0 ? e[1] : 0.0;
+      at.b[2] = e[2] > 0 ? e[2] : 0.0;
       return WalkEnd::arrived;
     }
-    const Face& f = s.faces[at.face];
-    // First edge reached: the smallest t with b_i + t db_i = 0.
+    const Face& f = s.faces[face];
+    // First edge reached: the smallest t with b_i + t (e_i − b_i) = 0.
     int exit = -1;
     double t_exit = 1.0;
     for (int i = 0; i < 3; ++i) {
       if (!reaches[i]) continue;
-      const double t = std::max(at.b[i], 0.0) / -db[i];
+      const double from = std::max(b[i], 0.0);
+      const double t = from / (from - e[i]);
       // Ties (a path through a vertex): prefer an interior edge so the walk does not stop on the
       // boundary while the surface continues in the direction of travel.
       constexpr double tie = 1e-12;
@@ -295,22 +309,33 @@ WalkEnd walk(const Surface& s, Location& at, Delta& d, std::vector<Crossed>* pat
         t_exit = t;
       }
     }
-    double b[3];
-    for (int i = 0; i < 3; ++i) b[i] = i == exit ? 0.0 : std::max(at.b[i] + t_exit * db[i], 0.0);
+    const int i1 = exit == 2 ? 0 : exit + 1, i2 = exit == 0 ? 2 : exit - 1;
+    const double reached1 = std::max(pick(b, i1) + t_exit * (pick(e, i1) - pick(b, i1)), 0.0);
+    const double reached2 = std::max(pick(b, i2) + t_exit * (pick(e, i2) - pick(b, i2)), 0.0);
     const int g = f.neighbour[exit];
     if (g < 0) {  // leaves the surface: stop on the boundary edge
-      for (int i = 0; i < 3; ++i) at.b[i] = b[i];
+      at.face = face;
+      at.b[exit] = 0.0;
+      at.b[i1] = reached1;
+      at.b[i2] = reached2;
       return WalkEnd::boundary;
     }
-    rest *= 1.0 - t_exit;
-    d = carry(f, exit, d);
+    // Into the neighbour's slots: jo opposite the edge, jn this face's corner i1, jt its corner i2.
+    // The permutation is done with selects, in registers: stores through a variable index would
+    // be read back by wider loads that the store buffer cannot forward.
     const int jo = f.across[exit] & 3, jn = f.across[exit] >> 2;
+    const double far = pick(e, exit) * f.unfold_far[exit];
+    const double next = pick(e, i1) - f.unfold_next[exit] * far;
+    const double third = 1.0 - far - next;
+    for (int k = 0; k < 3; ++k) {
+      e[k] = k == jo ? far : k == jn ? next : third;
+      b[k] = k == jo ? 0.0 : k == jn ? reached1 : reached2;
+    }
     if (path) path->push_back({g, jo});
-    at.face = g;
-    at.b[jo] = 0.0;
-    at.b[jn] = b[(exit + 1) % 3];
-    at.b[3 - jo - jn] = b[(exit + 2) % 3];
+    face = g;
   }
+  at.face = face;
+  for (int i = 0; i < 3; ++i) at.b[i] = b[i];
   return WalkEnd::stalled;
 }
 
@@ -318,14 +343,16 @@ WalkEnd walk(const Surface& s, Location& at, Delta& d, std::vector<Crossed>* pat
 inline Delta velocity_at(const Surface& s, const Location& at) {
   const FaceMotion& m = s.motion[at.face];
   Delta v;
-  for (int i = 0; i < 3; ++i) v.d[i] = at.b[0] * m.rate[0][i] + at.b[1] * m.rate[1][i] + at.b[2] * m.rate[2][i];
+  for (int i = 0; i < 2; ++i) v.d[i] = at.b[0] * m.rate[0][i] + at.b[1] * m.rate[1][i] + at.b[2] * m.rate[2][i];
+  v.d[2] = -(v.d[0] + v.d[1]);
   return v;
 }
 
 /// Squared length of an increment of face f, in units of its mean edge length.
 inline double cells2(const Surface& s, int face, const Delta& v) {
   const FaceMotion& m = s.motion[face];
-  return std::max(0.0, -(v.d[1] * v.d[2] * m.edge2[0] + v.d[0] * v.d[2] * m.edge2[1] + v.d[0] * v.d[1] * m.edge2[2]));
+  return std::max(0.0, -(v.d[1] * v.d[2] * double(m.edge2[0]) + v.d[0] * v.d[2] * double(m.edge2[1]) +
+                         v.d[0] * v.d[1] * double(m.edge2[2])));
 }
 
 struct TraceResult {
@@ -373,8 +400,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
           r.stalled = true;
           break;
         }
-        Delta d = (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-        const WalkEnd end = walk(s, x, d, nullptr);
+        const WalkEnd end = walk(s, x, (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4), nullptr);
         if (end != WalkEnd::arrived) {
           (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
           break;
@@ -384,8 +410,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
         // velocity of x's face (extended beyond it when the midpoint lies outside).
         Location mid = x;
         for (int i = 0; i < 3; ++i) mid.b[i] = x.b[i] - 0.5 * dt * k1.d[i];
-        Delta d = (-dt) * velocity_at(s, mid);
-        const WalkEnd end = walk(s, x, d, nullptr);
+        const WalkEnd end = walk(s, x, (-dt) * velocity_at(s, mid), nullptr);
         if (end != WalkEnd::arrived) {
           (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
           break;
