@@ -1,7 +1,7 @@
 // Advection benchmark: φ0 = β − π/4 (β the polar angle) carried along the unit field e_β for
 // T = π/4 in one advect() call, on geodesic spheres of 2.4k to 620k faces; exact φ(T) = β − a − T
 // where β > T. Errors in the band |β − π/2| < 0.25.
-//   bench_advection [out.csv] [--rk 4] [--cells C] [--repeat N] [--sizes 11,22,44]
+//   bench_advection [out.csv] [--rk 4] [--cells C] [--p1] [--repeat N] [--sizes 11,22,44]
 // (sizes are the sphere frequencies k, 20k² faces; times are medians over N calls, default 5)
 #include <bodyfit/advection.hpp>
 #include <bodyfit/generators.hpp>
@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
       options.rk_order = std::atoi(argv[++i]);
     } else if (!std::strcmp(argv[i], "--cells") && i + 1 < argc) {
       options.max_cells_per_substep = std::atof(argv[++i]);
+    } else if (!std::strcmp(argv[i], "--p1")) {
+      options.gradient_correction = false;
     } else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else if (!std::strcmp(argv[i], "--sizes") && i + 1 < argc) {
@@ -43,8 +45,9 @@ int main(int argc, char** argv) {
   const double a = M_PI / 4, T = M_PI / 4;
   std::ofstream out(csv);
   out << "faces,h,band_l2,band_linf,order,ms,cpu_ms,setup_ms,substeps,lost\n";
-  std::printf("advection of beta - pi/4 along e_beta, T = pi/4, RK%d, %.2f cells per sub-step\n", options.rk_order,
-              options.max_cells_per_substep);
+  std::printf("advection of beta - pi/4 along e_beta, T = pi/4, RK%d, %.2f cells per sub-step, %s\n",
+              options.rk_order, options.max_cells_per_substep,
+              options.gradient_correction ? "gradient-corrected values" : "plain P1 values");
   std::printf("%9s %9s %11s %11s %6s %9s %9s %9s %11s %5s\n", "faces", "h", "band L2", "band Linf", "order", "ms",
               "cpu ms", "setup ms", "substeps", "lost");
   double previous_l2 = 0, previous_h = 0;
