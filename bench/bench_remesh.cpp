@@ -1,6 +1,6 @@
 // Benchmark of discretize + remesh against the figures of `mmgs -ls` (docs/validation/remeshing.md).
 //
-//   bench_remesh [--quick] [csv]   (default csv: bench_remesh.csv)
+//   bench_remesh [--quick] [--spheres 9700,242000 (0: none)] [--no-terrain] [csv]   (default csv: bench_remesh.csv)
 //
 // Sphere: geodesic unit sphere, φ = β − π/4 (β = acos z), hmax = mean input edge; the remesher
 // projects onto the exact sphere. Terrain: make_terrain over [0,50]² (in km) with a 1 km disk, the
@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -113,19 +114,25 @@ SurfaceMesh make_km_terrain(std::size_t faces) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false;
+  bool quick = false, terrain = true;
   std::string csv = "bench_remesh.csv";
+  std::vector<std::size_t> sizes;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     if (a == "--quick") quick = true;
-    else csv = a;
+    else if (a == "--no-terrain") terrain = false;
+    else if (a == "--spheres" && i + 1 < argc) {
+      std::stringstream list(argv[++i]);
+      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stoul(item));
+    } else csv = a;
   }
   std::vector<Row> rows;
-  std::vector<std::size_t> sizes = quick ? std::vector<std::size_t>{9700} : std::vector<std::size_t>{9700, 60000, 242000};
+  if (sizes.empty()) sizes = quick ? std::vector<std::size_t>{9700} : std::vector<std::size_t>{9700, 60000, 242000};
 
   auto beta = [](const Vec3& p) { return std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0)); };
   auto sphere_distance = [](const Vec3& p) { return std::abs(p.norm() - 1.0); };
   for (std::size_t faces : sizes) {
+    if (faces == 0) continue;
     auto mesh = make_sphere({.faces = faces});
     double h = mean_edge(mesh);
     RemeshOptions options;
@@ -156,7 +163,7 @@ int main(int argc, char** argv) {
                 step.remesh_ms / rows[rows.size() - 3].remesh_ms);
   }
 
-  {
+  if (terrain) {
     std::size_t faces = quick ? 20000 : 240000;
     auto mesh = make_km_terrain(faces);
     auto reference = std::make_shared<const ReferenceSurface>(mesh);

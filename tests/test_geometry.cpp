@@ -72,3 +72,36 @@ TEST_CASE("l2_difference integrates squared P1 differences exactly (midpoint rul
   for (auto v : square.vertices()) affine[v.idx()] = 3 * square.point(v)[0] - square.point(v)[1];
   CHECK(l2_difference(square, affine, [](const Vec3& p) { return 3 * p[0] - p[1]; }) == doctest::Approx(0.0).epsilon(1e-14));
 }
+
+TEST_CASE("vertex gradients: exact for an affine function on a plane, tangential and convergent on the sphere") {
+  // Plane: the area-weighted average of exact face gradients is exact.
+  const SurfaceMesh square = test::grid_square(8);
+  ScalarField affine(square.n_vertices());
+  for (auto v : square.vertices()) affine[v.idx()] = 2.0 * square.point(v)[0] - 3.0 * square.point(v)[1] + 1.0;
+  const VectorField all = vertex_gradients(square, affine);
+  for (auto v : square.vertices()) {
+    CHECK((all[v.idx()] - Vec3(2, -3, 0)).norm() < 1e-12);
+    CHECK((vertex_gradient(square, v, affine) - all[v.idx()]).norm() < 1e-12);
+  }
+  // Sphere, u = z: the surface gradient is e_z − z n (n = x). The one-vertex and the one-pass
+  // forms agree, and the max error falls at first order (the valence-5 vertices).
+  auto worst_error = [](std::size_t faces) {
+    const SurfaceMesh sphere = make_sphere({.faces = faces});
+    ScalarField z(sphere.n_vertices());
+    for (auto v : sphere.vertices()) z[v.idx()] = sphere.point(v)[2];
+    const VectorField g = vertex_gradients(sphere, z);
+    double worst = 0, disagreement = 0;
+    for (auto v : sphere.vertices()) {
+      const Vec3 n = sphere.point(v).normalized();
+      const Vec3 exact = Vec3(0, 0, 1) - n[2] * n;
+      worst = std::max(worst, (g[v.idx()] - exact).norm());
+      CHECK(std::abs(OpenMesh::dot(g[v.idx()], vertex_normal(sphere, v))) < 1e-12);  // tangent to the mesh
+      disagreement = std::max(disagreement, (vertex_gradient(sphere, v, z) - g[v.idx()]).norm());
+    }
+    CHECK(disagreement < 1e-12);
+    return worst;
+  };
+  const double coarse = worst_error(1280), fine = worst_error(5120);
+  MESSAGE("max error " << coarse << " -> " << fine);
+  CHECK(std::log(coarse / fine) / std::log(2.0) > 0.9);  // h halves from 1280 to 5120 faces
+}

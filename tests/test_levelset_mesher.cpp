@@ -68,7 +68,7 @@ double min_quality(const SurfaceMesh& mesh) { return quality_stats(mesh).min; }
 
 }  // namespace
 
-TEST_CASE("spherical cap: crossing points are exactly the zeros of the linear interpolant") {
+TEST_CASE("spherical cap: with linear crossings, the points are exactly the zeros of the linear interpolant") {
   SurfaceMesh mesh = make_sphere({.faces = 5120});
   const std::size_t n0 = mesh.n_vertices();
   ScalarField phi = sample(mesh, [](const Vec3& p) { return polar_angle(p) - pi / 4; });
@@ -82,7 +82,7 @@ TEST_CASE("spherical cap: crossing points are exactly the zeros of the linear in
   }
   REQUIRE(expected.size() > 50);
 
-  auto report = discretize(mesh, phi, {.snap_ratio = 0});
+  auto report = discretize(mesh, phi, {.snap_ratio = 0, .hermite_crossings = false});
   require_valid(mesh, strict(2, 0));
   CHECK(report.crossed_edges == expected.size());
   CHECK(report.inserted_vertices == expected.size());
@@ -110,6 +110,41 @@ TEST_CASE("spherical cap: crossing points are exactly the zeros of the linear in
   }
   CHECK(region_components(mesh, kInside) == 1);
   CHECK(region_components(mesh, kOutside) == 1);
+}
+
+TEST_CASE("spherical cap: Hermite crossings are an order of magnitude closer to the level set than linear ones") {
+  // φ = β − π/4 sampled at the vertices; the exact cut is the circle β = π/4. A chord point p has
+  // the polar angle of its radial projection, so |β(p) − π/4| is its angular distance to the circle.
+  auto worst_error = [](std::size_t faces, bool hermite) {
+    SurfaceMesh mesh = make_sphere({.faces = faces});
+    ScalarField phi = sample(mesh, [](const Vec3& p) { return polar_angle(p) - pi / 4; });
+    discretize(mesh, phi, {.snap_ratio = 0, .hermite_crossings = hermite});
+    double worst = 0;
+    for (auto v : interface_vertices(mesh)) worst = std::max(worst, std::abs(polar_angle(mesh.point(v)) - pi / 4));
+    return std::pair{worst, edge_length_stats(mesh).mean};
+  };
+  const auto [linear_coarse, h_coarse] = worst_error(5120, false);
+  const auto [linear_fine, h_fine] = worst_error(20480, false);
+  const auto [hermite_coarse, h2] = worst_error(5120, true);
+  const auto [hermite_fine, h3] = worst_error(20480, true);
+  const double ratio = h_coarse / h_fine;
+  MESSAGE("linear " << linear_coarse << " -> " << linear_fine << ", Hermite " << hermite_coarse << " -> " << hermite_fine);
+  CHECK(std::log(linear_coarse / linear_fine) / std::log(ratio) > 1.7);
+  // Both second order (the vertex gradients limit the cubic), the Hermite constant ≈ 30× smaller.
+  CHECK(std::log(hermite_coarse / hermite_fine) / std::log(ratio) > 1.7);
+  CHECK(hermite_coarse < 0.1 * linear_coarse);
+  CHECK(hermite_fine < 0.1 * linear_fine);
+}
+
+TEST_CASE("Hermite and linear crossings agree when φ is affine along the edges") {
+  SurfaceMesh a = test::grid_square(12), b = test::grid_square(12);
+  ScalarField phi = sample(a, [](const Vec3& p) { return 0.7 * p[0] - 0.4 * p[1] - 0.1234; });
+  discretize(a, phi, {.snap_ratio = 0, .hermite_crossings = true});
+  discretize(b, phi, {.snap_ratio = 0, .hermite_crossings = false});
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  double worst = 0;
+  for (auto v : a.vertices()) worst = std::max(worst, (a.point(v) - b.point(v)).norm());
+  CHECK(worst < 1e-14);
 }
 
 TEST_CASE("spherical cap: region areas converge to the exact cap area at order 2") {

@@ -117,6 +117,17 @@ VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
   return result;
 }
 
+Vec3 vertex_gradient(const SurfaceMesh& mesh, VertexHandle v, const ScalarField& u) {
+  Vec3 sum(0, 0, 0);
+  double weight = 0;
+  for (auto f : mesh.vf_range(v)) {
+    const double area = face_area(mesh, f);
+    sum += area * face_gradient(mesh, f, u);
+    weight += area;
+  }
+  return weight > 0 ? project_tangent(sum / weight, vertex_normal(mesh, v)) : Vec3(0, 0, 0);
+}
+
 Vec3 project_tangent(const Vec3& v, const Vec3& unit_normal) {
   return v - OpenMesh::dot(v, unit_normal) * unit_normal;
 }

@@ -17,6 +17,27 @@ bool opposite_signs(double a, double b) { return (a < 0 && b > 0) || (a > 0 && b
 /// Position along (a, b) of the zero of the linear interpolant, as a fraction of |ab| from a.
 double zero_fraction(double a, double b) { return a / (a - b); }
 
+/// Zero of the cubic Hermite interpolant of values fa, fb and slopes ma, mb (per unit t) on [0, 1],
+/// by Newton's method from the linear zero; the linear zero when the cubic is not trustworthy
+/// there (see DiscretizeOptions::hermite_crossings).
+double hermite_zero_fraction(double fa, double fb, double ma, double mb) {
+  const double linear = zero_fraction(fa, fb);
+  const double secant = fb - fa;
+  if (ma * secant <= 0 || mb * secant <= 0) return linear;
+  double t = linear;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const double t2 = t * t, t3 = t2 * t;
+    const double value = (2 * t3 - 3 * t2 + 1) * fa + (t3 - 2 * t2 + t) * ma + (-2 * t3 + 3 * t2) * fb + (t3 - t2) * mb;
+    const double slope = (6 * t2 - 6 * t) * fa + (3 * t2 - 4 * t + 1) * ma + (-6 * t2 + 6 * t) * fb + (3 * t2 - 2 * t) * mb;
+    if (slope * secant <= 0) return linear;
+    const double step = value / slope;
+    t -= step;
+    if (!(t > 0 && t < 1) || std::abs(t - linear) > 0.25) return linear;
+    if (std::abs(step) < 1e-14) break;
+  }
+  return t;
+}
+
 /// The cut as it will be once every crossed edge is split, seen from one vertex where φ = 0:
 /// its number of interface edges. A face (v, w, x) whose w and x have strict opposite signs adds
 /// the segment from v to the crossing on wx; an edge (v, w) with φ(w) = 0 is interface when exactly
@@ -219,12 +240,32 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     auto it = std::lower_bound(crossed.begin(), crossed.end(), EdgeHandle(edge_index));
     return VertexHandle(first_crossing + int(it - crossed.begin()));
   };
+  // Vertex gradients of the input φ at the ends of the crossed edges (computed before any split).
+  std::vector<std::pair<int, Vec3>> gradient_at;
+  if (options.hermite_crossings) {
+    for (auto e : crossed)
+      for (int side = 0; side < 2; ++side) gradient_at.emplace_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)).idx(), Vec3());
+    std::sort(gradient_at.begin(), gradient_at.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    gradient_at.erase(std::unique(gradient_at.begin(), gradient_at.end(),
+                                  [](const auto& x, const auto& y) { return x.first == y.first; }),
+                      gradient_at.end());
+    for (auto& [v, g] : gradient_at) g = vertex_gradient(mesh, VertexHandle(v), phi);
+  }
+  auto slope_of = [&](VertexHandle v) {
+    auto it = std::lower_bound(gradient_at.begin(), gradient_at.end(), v.idx(),
+                               [](const auto& x, int key) { return x.first < key; });
+    return it->second;
+  };
   value.reserve(value.size() + crossed.size());
   for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
     auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);
-    double t = zero_fraction(value[a.idx()], value[b.idx()]);
-    Vec3 point = mesh.point(a) + t * (mesh.point(b) - mesh.point(a));
+    const Vec3 ab = mesh.point(b) - mesh.point(a);
+    const double t = options.hermite_crossings
+                         ? hermite_zero_fraction(value[a.idx()], value[b.idx()], OpenMesh::dot(slope_of(a), ab),
+                                                 OpenMesh::dot(slope_of(b), ab))
+                         : zero_fraction(value[a.idx()], value[b.idx()]);
+    Vec3 point = mesh.point(a) + t * ab;
     EdgeTags tags{mesh.edge_ref(e) == kInterfaceRef ? 0 : mesh.edge_ref(e), mesh.ridge(e), mesh.required(e)};
     auto p = mesh.add_vertex(point);
     mesh.vertex_ref(p) = 0;

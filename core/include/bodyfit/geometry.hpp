@@ -32,8 +32,10 @@ Vec3 face_gradient(const SurfaceMesh& mesh, FaceHandle f, const ScalarField& u);
 /// Per-face tangential gradients of u, indexed by face index.
 VectorField face_gradients(const SurfaceMesh& mesh, const ScalarField& u);
 /// Per-vertex gradients: area-weighted average of the face gradients around each vertex, then
-/// projected on the vertex's tangent plane.
+/// projected on the vertex's tangent plane (vertex_normal).
 VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u);
+/// The same at one vertex (for a few vertices; vertex_gradients is one pass over all faces).
+Vec3 vertex_gradient(const SurfaceMesh& mesh, VertexHandle v, const ScalarField& u);
 /// v − (v·n) n.
 Vec3 project_tangent(const Vec3& v, const Vec3& unit_normal);
 

@@ -14,6 +14,14 @@ struct DiscretizeOptions {
   /// the vertex does not move) instead of inserting a point next to it, which would leave a sliver.
   /// A snap that would make the interface touch itself at a vertex is not done. 0 disables snapping.
   double snap_ratio = 0.05;
+  /// Where a crossed edge is cut. true: at the zero of the cubic Hermite interpolant of φ along the
+  /// edge, whose end slopes come from the vertex gradients of φ (vertex_gradient): φ is a smooth
+  /// function sampled at the vertices, and the linear zero is off the true level set by
+  /// ≈ h²|φ''|/(8|φ'|) where the interface is curved. The cubic zero is used only when it lies within
+  /// a quarter edge of the linear one, the slopes agree in sign with φ(b) − φ(a), and it stays inside
+  /// the edge; otherwise, and when false, the zero of the linear interpolant (the paper's and
+  /// mmgs's rule; exact for φ affine along the edge, where both agree).
+  bool hermite_crossings = true;
 };
 
 struct DiscretizeReport {
