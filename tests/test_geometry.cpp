@@ -5,7 +5,9 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 using namespace bodyfit;
 
@@ -104,4 +106,30 @@ TEST_CASE("vertex gradients: exact for an affine function on a plane, tangential
   const double coarse = worst_error(1280), fine = worst_error(5120);
   MESSAGE("max error " << coarse << " -> " << fine);
   CHECK(std::log(coarse / fine) / std::log(2.0) > 0.9);  // h halves from 1280 to 5120 faces
+}
+
+TEST_CASE("z_order is a deterministic permutation that keeps consecutive points close") {
+  // Points of a 32 × 32 × 32 lattice in a scrambled order: consecutive points in the scrambled order
+  // are far apart; in Z-order they are neighbours most of the time.
+  std::vector<Vec3> points;
+  for (int k = 0; k < 32768; ++k) {
+    const int scrambled = int((std::uint64_t(k) * 2654435761u) % 32768u);  // a bijection (odd multiplier)
+    points.emplace_back(scrambled % 32, (scrambled / 32) % 32, scrambled / 1024);
+  }
+  const std::vector<int> order = z_order(points);
+  REQUIRE(order.size() == points.size());
+  std::vector<int> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  for (int i = 0; i < int(sorted.size()); ++i) CHECK_UNARY(sorted[i] == i);
+  CHECK(z_order(points) == order);
+  auto mean_step = [&](auto index_of) {
+    double sum = 0;
+    for (std::size_t i = 1; i < points.size(); ++i) sum += (points[index_of(i)] - points[index_of(i - 1)]).norm();
+    return sum / double(points.size() - 1);
+  };
+  const double scrambled_step = mean_step([](std::size_t i) { return i; });
+  const double z_step = mean_step([&](std::size_t i) { return std::size_t(order[i]); });
+  MESSAGE("mean step: scrambled " << scrambled_step << ", Z-order " << z_step);
+  CHECK(z_step < 2.0);
+  CHECK(z_step < 0.2 * scrambled_step);
 }

@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 namespace bodyfit {
 
@@ -139,6 +144,48 @@ std::array<double, 3> barycentric(const Vec3& p, const Vec3& a, const Vec3& b, c
   double la = OpenMesh::dot(OpenMesh::cross(c - b, p - b), n) / d;
   double lb = OpenMesh::dot(OpenMesh::cross(a - c, p - c), n) / d;
   return {la, lb, 1.0 - la - lb};
+}
+
+namespace {
+
+/// Spreads the low 21 bits of x to every third bit (Morton interleaving).
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+}  // namespace
+
+std::vector<int> z_order(const std::vector<Vec3>& points) {
+  BoundingBox box;
+  if (!points.empty()) box.min = box.max = points[0];
+  for (const Vec3& p : points) {
+    box.min.minimize(p);
+    box.max.maximize(p);
+  }
+  const Vec3 extent = box.max - box.min;
+  const double scale = double((1 << 21) - 1);
+  const int n = int(points.size());
+  std::vector<std::pair<std::uint64_t, int>> keyed(n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 8192), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i != range.end(); ++i) {
+      std::uint64_t code = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double t = extent[c] > 0 ? (points[i][c] - box.min[c]) / extent[c] : 0.0;
+        code |= spread_bits(std::uint64_t(std::clamp(t, 0.0, 1.0) * scale)) << c;
+      }
+      keyed[i] = {code, i};
+    }
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
 }
 
 BoundingBox bounding_box(const SurfaceMesh& mesh) {

@@ -1,11 +1,15 @@
 #include <bodyfit/projection.hpp>
 
+#include <bodyfit/geometry.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <numeric>
+
+#include <tbb/parallel_invoke.h>
 
 namespace bodyfit {
 
@@ -14,41 +18,44 @@ namespace detail {
 namespace {
 constexpr int kLeafSize = 4;
 
+/// Nodes of the subtree over n primitives (median splits down to leaves of kLeafSize): fixed by n,
+/// so every subtree's node ids are known before it is built and subtrees can be built in parallel.
+int subtree_nodes(int n) { return n <= kLeafSize ? 1 : 1 + subtree_nodes(n / 2) + subtree_nodes(n - n / 2); }
+
+/// Median splits of the Z-ordered primitives (a linear BVH): no partitioning, and each node's box
+/// is the union of its children's, so the build is linear after one sort.
 struct Builder {
   const std::vector<Vec3>& lo;
   const std::vector<Vec3>& hi;
   BoxTree& tree;
 
-  int build(int begin, int end) {
-    int id = int(tree.nodes.size());
-    tree.nodes.emplace_back();
-    Vec3 nlo(std::numeric_limits<double>::max()), nhi(-std::numeric_limits<double>::max());
-    Vec3 clo = nlo, chi = nhi;  // bounds of the box centres
-    for (int i = begin; i < end; ++i) {
-      int p = tree.order[i];
-      nlo.minimize(lo[p]);
-      nhi.maximize(hi[p]);
-      Vec3 c = (lo[p] + hi[p]) * 0.5;
-      clo.minimize(c);
-      chi.maximize(c);
-    }
-    tree.nodes[id].lo = nlo;
-    tree.nodes[id].hi = nhi;
+  /// Build the subtree over order[begin, end) into nodes[id, id + subtree_nodes(end − begin)).
+  void build(int id, int begin, int end) {
+    BoxTree::Node& node = tree.nodes[id];
     if (end - begin <= kLeafSize) {
-      tree.nodes[id].begin = begin;
-      tree.nodes[id].end = end;
-      return id;
+      node.begin = begin;
+      node.end = end;
+      node.lo = lo[tree.order[begin]];
+      node.hi = hi[tree.order[begin]];
+      for (int i = begin + 1; i < end; ++i) {
+        node.lo.minimize(lo[tree.order[i]]);
+        node.hi.maximize(hi[tree.order[i]]);
+      }
+      return;
     }
-    Vec3 ext = chi - clo;
-    int axis = ext[0] > ext[1] ? (ext[0] > ext[2] ? 0 : 2) : (ext[1] > ext[2] ? 1 : 2);
-    int mid = (begin + end) / 2;
-    std::nth_element(tree.order.begin() + begin, tree.order.begin() + mid, tree.order.begin() + end,
-                     [&](int a, int b) { return lo[a][axis] + hi[a][axis] < lo[b][axis] + hi[b][axis]; });
-    int left = build(begin, mid);
-    int right = build(mid, end);
-    tree.nodes[id].left = left;
-    tree.nodes[id].right = right;
-    return id;
+    const int mid = (begin + end) / 2;
+    node.left = id + 1;
+    node.right = id + 1 + subtree_nodes(mid - begin);
+    if (end - begin > 16384)  // the halves write disjoint nodes
+      tbb::parallel_invoke([&] { build(node.left, begin, mid); }, [&] { build(node.right, mid, end); });
+    else {
+      build(node.left, begin, mid);
+      build(node.right, mid, end);
+    }
+    node.lo = tree.nodes[node.left].lo;
+    node.hi = tree.nodes[node.left].hi;
+    node.lo.minimize(tree.nodes[node.right].lo);
+    node.hi.maximize(tree.nodes[node.right].hi);
   }
 };
 
@@ -91,11 +98,13 @@ void nearest(const BoxTree& tree, const Vec3& p, double& best2, Distance&& dista
 
 void BoxTree::build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
   nodes.clear();
-  order.resize(lo.size());
-  std::iota(order.begin(), order.end(), 0);
+  order.clear();
   if (lo.empty()) return;
-  nodes.reserve(2 * lo.size() / kLeafSize + 2);
-  Builder{lo, hi, *this}.build(0, int(lo.size()));
+  std::vector<Vec3> centre2(lo.size());
+  for (std::size_t i = 0; i < lo.size(); ++i) centre2[i] = lo[i] + hi[i];
+  order = z_order(centre2);
+  nodes.resize(std::size_t(subtree_nodes(int(lo.size()))));
+  Builder{lo, hi, *this}.build(0, 0, int(lo.size()));
 }
 
 }  // namespace detail
@@ -147,6 +156,7 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
     normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
   }
 }
+
 
 std::shared_ptr<ReferenceSurface> ReferenceSurface::sphere(const Vec3& center, double radius) {
   std::shared_ptr<ReferenceSurface> s(new ReferenceSurface());

@@ -40,6 +40,8 @@ constexpr double kCurveRepairQuality = 0.6;
 constexpr double kFlipBelow = 0.75;
 // Relocation spreads at most this many rings away from a topological change or a bad element.
 constexpr char kSmoothRings = 3;
+// A relocation moving a vertex by more than this fraction of its size re-queues its ring.
+constexpr double kMoveSpread = 0.05;
 
 struct Tri {
   double quality = 0;
@@ -663,7 +665,7 @@ RemeshReport Remesher::run() {
     for (auto v : to_smooth) {
       if (m_.status(v).deleted()) continue;
       double d = relocate(v);
-      if (d > 0.02 * m_.property(size_, v)) {
+      if (d > kMoveSpread * m_.property(size_, v)) {
         moved = true;
         char depth = m_.property(depth_, v);
         if (depth < kSmoothRings) {

@@ -49,6 +49,9 @@ struct BoundingBox {
   double diagonal() const { return (max - min).norm(); }
 };
 BoundingBox bounding_box(const SurfaceMesh& mesh);
+/// Indices of the points sorted by their Z-order (Morton) code in the points' bounding box (21 bits
+/// per axis), ties by index: a deterministic, spatially coherent order for cache-friendly sweeps.
+std::vector<int> z_order(const std::vector<Vec3>& points);
 
 struct QualityStats {
   double min = 0, mean = 0, max = 0;
