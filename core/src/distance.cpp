@@ -44,6 +44,76 @@ double triangle_update(const CornerGeometry& g, double da, double db) {
   return g.bb * ua - g.ab * ub <= 0 && g.aa * ub - g.ab * ua <= 0 ? t : kInf;
 }
 
+/// A tentative value with the geodesic curvature κ of the front there: κ > 0 when the front
+/// diverges (its centre of curvature lies behind it), κ < 0 when it converges, 0 when straight.
+struct FrontValue {
+  double d = kInf;
+  double kappa = 0;
+};
+
+/// Curvature of the front after it travels `step` from where it was κ, on a surface of Gaussian
+/// curvature K: the Riccati equation of parallel curves, dκ/ds = −κ² − K. The flat part is exact
+/// (κ / (1 + κ·step), a circle grows by the step); the Gaussian term is taken at first order.
+double carried_curvature(double kappa, double step, double gauss) {
+  const double grown = 1 + kappa * step;
+  return (grown > 1e-12 ? kappa / grown : kappa) - gauss * step;
+}
+
+/// Update of x from a and b whose front is a circle rather than a line: in the plane of the
+/// triangle, the centre S lies at distances 1/κ − d + d_a from a and 1/κ − d + d_b from b (the radius
+/// grows with d; 1/κ − d averaged over a and b), behind the edge ab for a diverging front and beyond
+/// it for a converging one, and d_x follows from |x − S|; the curvature at x is carried by the
+/// Riccati equation with the Gaussian curvature K of the surface there. On a flat surface this is
+/// exact for the distance to a circle, where the planar update errs by O(h²κ) at every step (which
+/// accumulates to O(h) over a march). Falls back to the planar update when the front is almost
+/// straight, the data are inconsistent, or the characteristic from S does not reach x through ab.
+FrontValue front_update(const CornerGeometry& g, double da, double db, double ka, double kb, double gauss) {
+  FrontValue out;
+  const double mean_d = 0.5 * (da + db), mean_k = 0.5 * (ka + kb);
+  auto planar = [&] {
+    out.d = triangle_update(g, da, db);
+    out.kappa = std::isfinite(out.d) ? carried_curvature(mean_k, out.d - mean_d, gauss) : mean_k;
+    return out;
+  };
+  const double longest = std::sqrt(std::max(g.aa, g.bb));
+  // Fronts curving by less than 1e-4 per edge length, or of mixed sense, are straight here.
+  if (std::abs(ka) * longest < 1e-4 || std::abs(kb) * longest < 1e-4 || ka * kb <= 0) return planar();
+  const double R = 0.5 * ((1 / ka - da) + (1 / kb - db));  // signed radius minus distance
+  const double signed_a = da + R, signed_b = db + R;
+  const bool diverging = signed_a > 0 && signed_b > 0;
+  if (!diverging && !(signed_a < 0 && signed_b < 0)) return planar();
+  // x at the origin, a on the first axis, b above it: x lies on the left of the line a → b.
+  const double la = std::sqrt(g.aa);
+  const double ax = la, bx = g.ab / la, by = std::sqrt(std::max(g.bb - bx * bx, 0.0));
+  const double ex = bx - ax, ey = by, length = std::hypot(ex, ey);
+  if (!(by > 0) || !(length > 0)) return planar();
+  const double ux = ex / length, uy = ey / length;  // along a → b; its left normal is (−uy, ux)
+  const double rad_a = std::abs(signed_a), rad_b = std::abs(signed_b);
+  const double along = ((rad_a - rad_b) * (rad_a + rad_b) + length * length) / (2 * length);
+  const double across2 = (rad_a - along) * (rad_a + along);
+  if (across2 < 0) return planar();
+  // Behind the edge (right of a → b, away from x) when diverging, on x's side when converging.
+  const double across = diverging ? -std::sqrt(across2) : std::sqrt(across2);
+  const double sx = ax + along * ux - across * uy, sy = along * uy + across * ux;
+  const double to_x = std::hypot(sx, sy);
+  // The characteristic is the line through S and x: it must cross the edge ab at a point P before
+  // x (between S and x when diverging, beyond x seen from S when converging).
+  const double cross_s = ex * sy - ey * sx, cross_a = -ey * ax;  // e × S and e × A (A = (ax, 0))
+  if (cross_s == 0) return planar();
+  const double keep = cross_a / cross_s;  // P = keep · S
+  const double px = keep * sx, py = keep * sy;
+  const double mu = ((px - ax) * ux + py * uy) / length;
+  if (mu < 0 || mu > 1 || (diverging ? !(keep > 0 && keep < 1) : !(keep < 0))) return planar();
+  // |x − S| − |a − S| without cancellation: (|S|² − |S − A|²) / (|S| + |S − A|) = (2 S·A − |A|²) / (…).
+  const double grow_a = (2 * sx * ax - ax * ax) / (to_x + rad_a);
+  const double grow_b = (2 * (sx * bx + sy * by) - g.bb) / (to_x + rad_b);
+  const double value = diverging ? 0.5 * (da + grow_a + db + grow_b) : 0.5 * (da - grow_a + db - grow_b);
+  if (!(value >= std::max(da, db)) || !(to_x > 0)) return planar();
+  out.d = value;
+  out.kappa = (diverging ? 1 / to_x : -1 / to_x) - gauss * (value - mean_d);
+  return out;
+}
+
 /// For an obtuse corner: the vertex r found by unfolding the faces beyond the opposite edge that
 /// splits the angle into two acute ones, with the geometry of the virtual triangles (x; a, r) and
 /// (x; r, b).
@@ -236,6 +306,18 @@ double point_arc_distance(const Vec3& p, const Vec3& a, const Vec3& b, const Vec
   return (p - (a + e * t) - bulge).norm();
 }
 
+/// Signed curvature of the interface arc (ka, kb) at the foot of p, seen from p: positive when p
+/// lies on the convex side (the fronts around p diverge), negative on the concave side.
+double curvature_seen_from(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& ka, const Vec3& kb) {
+  const Vec3 e = b - a;
+  const double len2 = e.sqrnorm();
+  double t = len2 > 0 ? ((p - a) | e) / len2 : 0.0;
+  t = std::clamp(t, 0.0, 1.0);
+  const Vec3 away = p - (a + e * t);
+  const double length = away.norm();
+  return length > 0 ? -((ka * (1 - t) + kb * t) | away) / length : 0.0;
+}
+
 /// What the initialisation needs: the sign of each vertex (−1, 0, +1) and, for every face touched
 /// by the interface, the interface segments inside it.
 struct Seeds {
@@ -370,10 +452,38 @@ constexpr double kNearRadius = 2.5;
 using HeapEntry = std::pair<double, int>;
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<>>;
 
+/// Discrete Gaussian curvature at each vertex: angle defect over a third of the incident area
+/// (0 on the boundary, where the defect measures the boundary's turning instead).
+std::vector<double> gaussian_curvature(const FlatMesh& m) {
+  std::vector<double> angle(m.nv, 0.0), area(m.nv, 0.0);
+  std::vector<char> boundary(m.nv, 0);
+  for (std::size_t f = 0; f < m.nf; ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int v = m.corner_vertex[3 * f + c];
+      const Vec3& p = m.points[v];
+      const Vec3 u = m.points[m.corner_vertex[3 * f + (c + 1) % 3]] - p, w = m.points[m.corner_vertex[3 * f + (c + 2) % 3]] - p;
+      angle[v] += std::atan2((u % w).norm(), u | w);
+      area[v] += (u % w).norm() / 6;
+      if (m.across[3 * f + c] < 0) {  // the edge opposite c is a boundary edge: both its ends are
+        boundary[m.corner_vertex[3 * f + (c + 1) % 3]] = 1;
+        boundary[m.corner_vertex[3 * f + (c + 2) % 3]] = 1;
+      }
+    }
+  std::vector<double> gauss(m.nv, 0.0);
+  for (std::size_t v = 0; v < m.nv; ++v)
+    if (!boundary[v] && area[v] > 0) gauss[v] = (2 * std::numbers::pi - angle[v]) / area[v];
+  return gauss;
+}
+
 ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options,
                   DistanceReport& report) {
   const std::size_t nv = m.nv;
   std::vector<double> dist(nv, kInf);
+  // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's when
+  // it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
+  const bool track = options.front_curvature && !seeds.bends.empty();
+  std::vector<double> kappa(nv, 0.0);
+  const std::vector<double> gauss = track ? gaussian_curvature(m) : std::vector<double>();
   // 0 far, 1 tentative, 2 fixed by the initialisation (final, not yet expanded), 3 accepted
   std::vector<std::uint8_t> state(nv, 0);
   report.has_interface = !seeds.faces.empty();
@@ -409,13 +519,26 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
     for (int w : ring) {
       const Vec3& p = m.points[w];
       double best = dist[w];
+      int best_segment = -1;
       for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k) {
         const auto& [a, b] = seeds.segments[k];
-        best = std::min(best, seeds.bends.empty()
-                                  ? point_segment_distance(p, a, b)
-                                  : point_arc_distance(p, a, b, seeds.bends[k].first, seeds.bends[k].second));
+        const double value = seeds.bends.empty()
+                                 ? point_segment_distance(p, a, b)
+                                 : point_arc_distance(p, a, b, seeds.bends[k].first, seeds.bends[k].second);
+        // On a tie (an interface vertex is also the end of its edges) an edge gives the curvature.
+        const bool point_so_far = best_segment >= 0 && seeds.segments[best_segment].first == seeds.segments[best_segment].second;
+        if (value < best || (value == best && point_so_far && a != b)) {
+          best = value;
+          best_segment = k;
+        }
       }
+      if (best_segment < 0) continue;  // an earlier seed face was closer
       dist[w] = best;
+      if (track) {
+        const auto& [a, b] = seeds.segments[best_segment];
+        const auto& [ka, kb] = seeds.bends[best_segment];
+        kappa[w] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss[w]);
+      }
     }
   }
   MinHeap heap;
@@ -434,14 +557,25 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
 
   auto known = [&](int v) { return state[v] >= 2; };
   // Update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
+  auto update = [&](const CornerGeometry& g, int a, int b, int x) {
+    if (!track) return FrontValue{triangle_update(g, dist[a], dist[b])};
+    return front_update(g, dist[a], dist[b], kappa[a], kappa[b], (gauss[a] + gauss[b] + gauss[x]) / 3);
+  };
   auto split_update = [&](int split) {
     const ObtuseSplit& s = m.splits[split];
-    double value = kInf;
+    FrontValue value;
     if (!known(s.vertex)) return value;
     const int f = s.corner / 3, c = s.corner % 3;
+    const int x = m.corner_vertex[s.corner];
     const int a = m.corner_vertex[3 * f + (c + 1) % 3], b = m.corner_vertex[3 * f + (c + 2) % 3];
-    if (known(a)) value = std::min(value, triangle_update(s.first, dist[a], dist[s.vertex]));
-    if (known(b)) value = std::min(value, triangle_update(s.second, dist[s.vertex], dist[b]));
+    if (known(a)) {
+      const FrontValue first = update(s.first, a, s.vertex, x);
+      if (first.d < value.d) value = first;
+    }
+    if (known(b)) {
+      const FrontValue second = update(s.second, s.vertex, b, x);
+      if (second.d < value.d) value = second;
+    }
     return value;
   };
   while (!heap.empty()) {
@@ -460,18 +594,22 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
         const int y = side == 0 ? t.b : t.a;
         const Vec3& px = m.points[x];
         const Vec3 ev = pv - px;
-        double value = kInf;
+        FrontValue value;
         if (!(t.obtuse & (1 << side))) {
-          if (known(y)) value = triangle_update(corner_geometry(ev, m.points[y] - px), d, dist[y]);
+          if (known(y)) value = update(corner_geometry(ev, m.points[y] - px), v, y, x);
         } else {  // obtuse angle at x: the two acute virtual triangles of the unfolding
           const int split = m.obtuse[3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3];
           if (split >= 0) value = split_update(split);
         }
-        if (value == kInf) value = d + ev.norm();
-        if (value < dist[x]) {
-          dist[x] = value;
+        if (value.d == kInf) {
+          const double length = ev.norm();
+          value = {d + length, track ? carried_curvature(kappa[v], length, gauss[x]) : 0.0};
+        }
+        if (value.d < dist[x]) {
+          dist[x] = value.d;
+          kappa[x] = value.kappa;
           state[x] = 1;
-          heap.emplace(value, x);
+          heap.emplace(value.d, x);
         }
       }
     }
@@ -480,11 +618,12 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
       const int split = m.split_list[j];
       const int x = m.corner_vertex[m.splits[split].corner];
       if (known(x)) continue;
-      const double value = split_update(split);
-      if (value < dist[x]) {
-        dist[x] = value;
+      const FrontValue value = split_update(split);
+      if (value.d < dist[x]) {
+        dist[x] = value.d;
+        kappa[x] = value.kappa;
         state[x] = 1;
-        heap.emplace(value, x);
+        heap.emplace(value.d, x);
       }
     }
   }

@@ -16,6 +16,12 @@ struct DistanceOptions {
   /// Edges with an end that is not a smooth curve point (interface-degree ≠ 2, on the boundary of
   /// S, or a turn above 30°) stay straight. The φ mode ignores it (its zero set is O(h²) anyway).
   bool curved_interface = true;
+  /// Region mode with curved_interface: carry the geodesic curvature of the front from the
+  /// interface's (Riccati equation of parallel curves, dκ/ds = −κ² − K, K the discrete Gaussian
+  /// curvature) and update with circular fronts instead of straight ones. The planar update errs by
+  /// O(h²κ) wherever the front is curved, which adds up to a first-order error far from the
+  /// interface.
+  bool front_curvature = true;
 };
 
 struct DistanceReport {
