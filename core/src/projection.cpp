@@ -22,40 +22,47 @@ constexpr int kLeafSize = 4;
 /// so every subtree's node ids are known before it is built and subtrees can be built in parallel.
 int subtree_nodes(int n) { return n <= kLeafSize ? 1 : 1 + subtree_nodes(n / 2) + subtree_nodes(n - n / 2); }
 
-/// Median splits of the Z-ordered primitives (a linear BVH): no partitioning, and each node's box
-/// is the union of its children's, so the build is linear after one sort.
+/// Median splits along the longest axis of the box centres: tight boxes, so queries visit few
+/// nodes (median splits of the Z-order built 3× faster but made the remesher's queries 3× slower).
+/// The two halves are built in parallel.
 struct Builder {
   const std::vector<Vec3>& lo;
   const std::vector<Vec3>& hi;
+  const std::vector<Vec3>& centre2;  ///< lo + hi (twice the box centres)
   BoxTree& tree;
 
   /// Build the subtree over order[begin, end) into nodes[id, id + subtree_nodes(end − begin)).
   void build(int id, int begin, int end) {
     BoxTree::Node& node = tree.nodes[id];
+    Vec3 nlo(std::numeric_limits<double>::max()), nhi(-std::numeric_limits<double>::max());
+    Vec3 clo = nlo, chi = nhi;  // bounds of the box centres
+    for (int i = begin; i < end; ++i) {
+      const int p = tree.order[i];
+      nlo.minimize(lo[p]);
+      nhi.maximize(hi[p]);
+      clo.minimize(centre2[p]);
+      chi.maximize(centre2[p]);
+    }
+    node.lo = nlo;
+    node.hi = nhi;
     if (end - begin <= kLeafSize) {
       node.begin = begin;
       node.end = end;
-      node.lo = lo[tree.order[begin]];
-      node.hi = hi[tree.order[begin]];
-      for (int i = begin + 1; i < end; ++i) {
-        node.lo.minimize(lo[tree.order[i]]);
-        node.hi.maximize(hi[tree.order[i]]);
-      }
       return;
     }
+    const Vec3 ext = chi - clo;
+    const int axis = ext[0] > ext[1] ? (ext[0] > ext[2] ? 0 : 2) : (ext[1] > ext[2] ? 1 : 2);
     const int mid = (begin + end) / 2;
+    std::nth_element(tree.order.begin() + begin, tree.order.begin() + mid, tree.order.begin() + end,
+                     [&](int a, int b) { return centre2[a][axis] < centre2[b][axis]; });
     node.left = id + 1;
     node.right = id + 1 + subtree_nodes(mid - begin);
-    if (end - begin > 16384)  // the halves write disjoint nodes
+    if (end - begin > 16384)  // the halves write disjoint ranges of `order` and `nodes`
       tbb::parallel_invoke([&] { build(node.left, begin, mid); }, [&] { build(node.right, mid, end); });
     else {
       build(node.left, begin, mid);
       build(node.right, mid, end);
     }
-    node.lo = tree.nodes[node.left].lo;
-    node.hi = tree.nodes[node.left].hi;
-    node.lo.minimize(tree.nodes[node.right].lo);
-    node.hi.maximize(tree.nodes[node.right].hi);
   }
 };
 
@@ -102,9 +109,10 @@ void BoxTree::build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
   if (lo.empty()) return;
   std::vector<Vec3> centre2(lo.size());
   for (std::size_t i = 0; i < lo.size(); ++i) centre2[i] = lo[i] + hi[i];
-  order = z_order(centre2);
+  order.resize(lo.size());
+  std::iota(order.begin(), order.end(), 0);
   nodes.resize(std::size_t(subtree_nodes(int(lo.size()))));
-  Builder{lo, hi, *this}.build(0, 0, int(lo.size()));
+  Builder{lo, hi, centre2, *this}.build(0, 0, int(lo.size()));
 }
 
 }  // namespace detail
