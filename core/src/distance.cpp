@@ -66,7 +66,8 @@ double carried_curvature(double kappa, double step, double gauss) {
 /// Riccati equation with the Gaussian curvature K of the surface there. On a flat surface this is
 /// exact for the distance to a circle, where the planar update errs by O(h²κ) at every step (which
 /// accumulates to O(h) over a march). Falls back to the planar update when the front is almost
-/// straight, the data are inconsistent, or the characteristic from S does not reach x through ab.
+/// straight or the data are inconsistent; gives no value (d = ∞) when the characteristic from S
+/// does not reach x through ab.
 FrontValue front_update(const CornerGeometry& g, double da, double db, double ka, double kb, double gauss) {
   FrontValue out;
   const double mean_d = 0.5 * (da + db), mean_k = 0.5 * (ka + kb);
@@ -103,7 +104,9 @@ FrontValue front_update(const CornerGeometry& g, double da, double db, double ka
   const double keep = cross_a / cross_s;  // P = keep · S
   const double px = keep * sx, py = keep * sy;
   const double mu = ((px - ax) * ux + py * uy) / length;
-  if (mu < 0 || mu > 1 || (diverging ? !(keep > 0 && keep < 1) : !(keep < 0))) return planar();
+  // Not through this edge: another triangle of x carries the characteristic (as the planar
+  // update's own causality test would say), so no value from this one.
+  if (mu < 0 || mu > 1 || (diverging ? !(keep > 0 && keep < 1) : !(keep < 0))) return out;
   // |x − S| − |a − S| without cancellation: (|S|² − |S − A|²) / (|S| + |S − A|) = (2 S·A − |A|²) / (…).
   const double grow_a = (2 * sx * ax - ax * ax) / (to_x + rad_a);
   const double grow_b = (2 * (sx * bx + sy * by) - g.bb) / (to_x + rad_b);
