@@ -3,6 +3,7 @@
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/parameters.hpp>
 
 #include "test_support.hpp"
 
@@ -73,6 +74,8 @@ TEST_CASE("a valid case is read into its options") {
   CHECK(c.time.dt == 0);
   CHECK(c.time.final_time == 0.78);
   CHECK(c.time.iterations == -1);
+  CHECK(c.time.max_cfl == 0);  // no sub-steps unless asked for
+  CHECK(parse(kValidCase, {"time.max_cfl=4"}).time.max_cfl == 4);
   CHECK(c.remesh.hmax == 0.2);
   CHECK(c.output.vtu_every == 1);
 }
@@ -139,6 +142,10 @@ TEST_CASE("wrong types and values are errors naming the key") {
   CHECK_MESSAGE(contains(e, "extent: does not apply to generator 'sphere'"), e);
   e = error_of(kValidCase, {"time.dt=0.1"});
   CHECK_MESSAGE(contains(e, "exactly one of 'dt' and 'cfl'"), e);
+  e = error_of(kValidCase, {"time.max_cfl=0"});
+  CHECK_MESSAGE(contains(e, "[time] max_cfl: must be > 0"), e);
+  e = error_of(kValidCase, {"time.max_cf=2"});
+  CHECK_MESSAGE(contains(e, "unknown key 'max_cf' in [time]; did you mean 'max_cfl'?"), e);
 }
 
 TEST_CASE("--set overrides any key with a dotted path, typed as TOML") {
@@ -242,4 +249,40 @@ iterations = 1
     double expected = 2.0 * std::min(beta - std::numbers::pi / 6, (std::numbers::pi - beta) - std::numbers::pi / 3);
     CHECK(phi[v.idx()] == doctest::Approx(expected).epsilon(1e-9));
   }
+}
+
+TEST_CASE("Parameters::path resolves file names against the case file, --set values against the working directory") {
+  namespace fs = std::filesystem;
+  test::TempDir dir("case_paths");
+  fs::create_directories(dir / "cases");
+  {
+    std::ofstream out(dir / "cases" / "c.toml");
+    std::string text = kValidCase;
+    const std::string speed = "speed = 2.0\n";
+    text.replace(text.find(speed), speed.size(),
+                 speed + "grid = \"maps/fuel.asc\"\nup = \"../dem.asc\"\nabsolute = \"/data/x.asc\"\n"
+                         "wind = { u_file = \"u.asc\" }\n");
+    out << text;
+  }
+  const fs::path cases = fs::absolute(dir / "cases");
+  // Read from another working directory, through a relative name of the case file.
+  const auto previous = fs::current_path();
+  fs::current_path(dir.path());
+  CaseConfig c = read_case(fs::path("cases") / "c.toml", {"model.override=\"o.asc\""});
+  Parameters p(c.model_parameters, "model");
+  CHECK(p.path("grid") == cases / "maps" / "fuel.asc");
+  CHECK(p.path("up") == dir.path() / "dem.asc");
+  CHECK(p.path("absolute") == fs::path("/data/x.asc"));
+  CHECK(p.path("override") == fs::absolute(dir.path()) / "o.asc");  // --set: the working directory
+  CHECK(p.path("absent", "default.asc") == fs::path("default.asc"));
+  CHECK(p.path("absent").empty());
+  Parameters wind(*p.table("wind"), "model.wind");
+  CHECK(wind.path("u_file") == cases / "u.asc");  // nested tables keep their source too
+  // A table parsed from a string has no file: its names are relative to the working directory.
+  toml::table text = toml::parse("f = \"a/b.asc\"");
+  CHECK(Parameters(text).path("f") == fs::absolute(dir.path()) / "a" / "b.asc");
+  fs::current_path(previous);
+  // Not a string: the usual typed error.
+  toml::table wrong = toml::parse("f = 3");
+  CHECK_THROWS_AS(Parameters(wrong).path("f"), InputError);
 }

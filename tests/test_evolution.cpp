@@ -221,3 +221,26 @@ TEST_CASE("bodyfit run writes its outputs, and --resume gives the same final mes
   CHECK(no_checkpoint.exit_code == 1);
   CHECK(no_checkpoint.output.find("no checkpoint") != std::string::npos);
 }
+
+TEST_CASE("[time] max_cfl: a long step is made of sub-steps on the same mesh, and the disk still grows at unit speed") {
+  // Δt = 0.15 = 3h; with max_cfl = 1 each step is made of 3 sub-steps of 0.05 (|V| = 1).
+  Outcome o = run(kPlane, {"time.cfl=3.0", "time.max_cfl=1.0"});
+  CHECK(o.result.reason == StopReason::FinalTime);
+  REQUIRE(o.result.records.size() == 2);
+  for (const auto& rec : o.result.records) {
+    CAPTURE(rec.iteration);
+    CHECK(rec.substeps == 3);
+    CHECK(rec.dt == doctest::Approx(0.15));
+    bool reported = false;
+    for (const auto& [name, value] : rec.metrics) reported |= name == "substeps" && value == 3;
+    CHECK(reported);
+    const double radius = std::sqrt(rec.area / kPi);
+    CHECK(std::abs(radius - (0.3 + rec.time)) < 0.3 * 0.05);
+    CHECK(rec.components == 1);
+  }
+  CHECK(o.result.records.back().time == doctest::Approx(0.3));
+  // Without the cap, one pass per step.
+  Outcome plain = run(kPlane, {"time.cfl=3.0"});
+  CHECK(plain.result.records.front().substeps == 1);
+  for (const auto& [name, value] : plain.result.records.front().metrics) CHECK(name != "substeps");
+}

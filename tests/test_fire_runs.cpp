@@ -213,10 +213,11 @@ TEST_CASE("a fuel map's non-burnable cells stop the front") {
 }
 
 TEST_CASE("the fire cases of meshes/cases are valid and configure the plugin") {
-  // The [model] paths (fuel map, arrival raster) are relative to the working directory: the
-  // repository root, as docs/fire.md says.
+  // The [model] paths (fuel map, arrival raster) are relative to the case file: read from an
+  // unrelated working directory.
+  test::TempDir elsewhere("fire_cases_cwd");
   const auto previous = std::filesystem::current_path();
-  std::filesystem::current_path(test::source_path("."));
+  std::filesystem::current_path(elsewhere.path());
   for (const char* name : {"fire_one_disk", "fire_four_disks", "fire_rotating_wind", "fire_luxembourg"}) {
     CAPTURE(name);
     CaseConfig c = read_case(test::source_path(std::string("meshes/cases/") + name + ".toml"));
@@ -225,4 +226,59 @@ TEST_CASE("the fire cases of meshes/cases are valid and configure the plugin") {
     CHECK_NOTHROW(configure_model(model, c.model_parameters));
   }
   std::filesystem::current_path(previous);
+}
+
+TEST_CASE("[model] file names are relative to the case file: a run from another directory, its --resume, a missing file") {
+  namespace fs = std::filesystem;
+  test::TempDir dir("fire_paths");
+  fs::create_directories(dir / "case" / "maps");
+  fs::create_directories(dir / "elsewhere");
+  auto grid = [&](const std::string& name, double value) {
+    std::ofstream out(dir / "case" / "maps" / name);
+    out << "ncols 25\nnrows 25\nxllcorner 0\nyllcorner 0\ncellsize 40\nNODATA_value -9999\n";
+    for (int i = 0; i < 25 * 25; ++i) out << value << (i % 25 == 24 ? "\n" : " ");
+  };
+  grid("flat.asc", 0), grid("fuel.asc", 1), grid("u.asc", 2), grid("v.asc", 0);
+  auto write_case = [&](const std::string& file, const std::string& fuel_map) {
+    std::ofstream out(dir / "case" / file);
+    out << "[surface]\ngenerator = \"terrain\"\ndem = \"maps/flat.asc\"\nh = 40.0\n"
+        << "[region]\nshape = \"disks\"\ncenters = [[500.0, 500.0]]\nradii = [150.0]\n"
+        << "[model]\nname = \"fire\"\n"
+        << "wind = { type = \"grid\", u_file = \"maps/u.asc\", v_file = \"./maps/v.asc\" }\n"
+        << "fuel = { map = \"" << fuel_map << "\", presets = [\"balbi2009\"] }\n"
+        << "arrival = { like = \"maps/flat.asc\" }\n"
+        << "[time]\ndt = 30.0\niterations = 3\n[output]\nvtu_every = 0\n";
+  };
+  write_case("case.toml", "maps/fuel.asc");
+  write_case("missing.toml", "maps/nope.asc");
+  const auto previous = fs::current_path();
+  auto history_rows = [&] {
+    std::ifstream in(dir / "elsewhere" / "out" / "history.csv");
+    std::vector<std::string> rows;
+    for (std::string line; std::getline(in, line);) rows.push_back(line);
+    return rows;
+  };
+
+  fs::current_path(dir / "elsewhere");
+  auto first = test::run_bodyfit("run ../case/case.toml -o out --set time.iterations=2");
+  INFO(first.output);
+  CHECK(first.exit_code == 0);
+  CHECK(fs::exists(dir / "elsewhere" / "out" / "arrival_time.asc"));
+  CHECK(history_rows().size() == 4);  // header, states 0..2
+
+  // --resume reads the case given on its command line again: from a third directory, same files.
+  fs::current_path(dir.path());
+  auto resumed = test::run_bodyfit("run case/case.toml -o elsewhere/out --resume");
+  INFO(resumed.output);
+  CHECK(resumed.exit_code == 0);
+  auto rows = history_rows();
+  REQUIRE(rows.size() == 5);
+  CHECK(rows.back().rfind("3,", 0) == 0);
+
+  // A missing file is named by its resolved path (next to the case file, not in the working directory).
+  auto missing = test::run_bodyfit("run case/missing.toml -o elsewhere/missing");
+  fs::current_path(previous);
+  INFO(missing.output);
+  CHECK(missing.exit_code == 1);
+  CHECK(missing.output.find((fs::absolute(dir / "case") / "maps" / "nope.asc").string()) != std::string::npos);
 }

@@ -348,6 +348,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     auto& out = config.time;
     out.dt = s.positive("dt", 0);
     out.cfl = s.positive("cfl", 0);
+    out.max_cfl = s.positive("max_cfl", 0);
     out.final_time = s.positive("final_time", out.final_time);
     out.iterations = s.integer("iterations", -1);
     s.check_unknown();  // first: a misspelt key often explains a missing one
@@ -420,6 +421,10 @@ CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::s
   try {
     CaseConfig config = parse_case(table, file.parent_path());
     config.file = file;
+    // Moved, not copied: toml++ copies drop the source file of each value, which
+    // Parameters::path needs to resolve a model's file names against the case file.
+    config.model_parameters = std::move(*table["model"].as_table());
+    config.model_parameters.erase("name");
     return config;
   } catch (const InputError& e) {
     throw file_error(file, e.what());
@@ -504,6 +509,8 @@ CaseSetup setup_case(const CaseConfig& config) {
   setup.h = config.remesh.hmax > 0 ? config.remesh.hmax : mean_edge_length(mesh);
   options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * setup.h;
   options.final_time = config.time.final_time;
+  options.max_cfl = config.time.max_cfl;
+  options.cfl_length = setup.h;
   options.max_iterations = config.time.iterations;
   options.distance = config.distance;
   options.advection = config.advection;

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -136,72 +137,104 @@ EvolutionResult evolve(SurfaceMesh& mesh, VelocityModel& model, const EvolutionO
     double dt = options.dt;
     if (options.final_time - t < dt + tiny) dt = options.final_time - t;  // land exactly on T
 
+    // One step of dt. With the CFL cap, (1)-(3) are repeated in sub-steps on the same mesh T^n:
+    // d is recomputed from the advected φ (its zero set kept inside the elements), V from d; the
+    // cut and the remesh (4) happen once, at the end of the step.
     IterationRecord record;
-    Stopwatch clock;
-    // (1) distance and velocity on T^n.
-    ScalarField d = signed_distance_to_region(mesh, options.distance);
-    record.ms.distance = clock.lap_ms();
-    StepState state;
-    state.mesh = &mesh;
-    state.distance = &d;
-    state.time = t;
-    state.dt = dt;
-    state.iteration = n;
-    state.output_dir = options.output_dir;
-    state.terrain = options.terrain;
-    VelocityField field;
-    VectorField velocity;
-    {
-      StepContext context = make_step_context(state);
-      field = model.compute(context);
-      if (field.kind == VelocityField::Kind::Tangential) {
-        velocity = std::move(field.vector);
-      } else {
-        const VectorField& conormal = context.conormal();
-        if (field.normal_speed.size() != mesh.n_vertices())
-          throw InputError(fmt::format("model '{}': {} normal speeds for {} vertices", model.name(),
-                                       field.normal_speed.size(), mesh.n_vertices()));
-        velocity.resize(mesh.n_vertices());
-        for (std::size_t i = 0; i < velocity.size(); ++i) velocity[i] = field.normal_speed[i] * conormal[i];
+    std::vector<std::pair<std::string, double>> metrics;
+    int passes = 0;
+    double done = 0;  // time advanced within this step
+    ScalarField phi_next;
+    while (done < dt) {
+      const double remaining = dt - done;
+      Stopwatch clock;
+      // (1) distance and velocity.
+      ScalarField d = passes == 0 ? signed_distance_to_region(mesh, options.distance)
+                                  : signed_distance(mesh, phi_next, options.distance);
+      record.ms.distance += clock.lap_ms();
+      StepState state;
+      state.mesh = &mesh;
+      state.distance = &d;
+      state.time = t + done;
+      state.dt = remaining;
+      state.iteration = n;
+      state.output_dir = options.output_dir;
+      state.terrain = options.terrain;
+      VelocityField field;
+      VectorField velocity;
+      {
+        StepContext context = make_step_context(state);
+        field = model.compute(context);
+        if (field.kind == VelocityField::Kind::Tangential) {
+          velocity = std::move(field.vector);
+        } else {
+          const VectorField& conormal = context.conormal();
+          if (field.normal_speed.size() != mesh.n_vertices())
+            throw InputError(fmt::format("model '{}': {} normal speeds for {} vertices", model.name(),
+                                         field.normal_speed.size(), mesh.n_vertices()));
+          velocity.resize(mesh.n_vertices());
+          for (std::size_t i = 0; i < velocity.size(); ++i) velocity[i] = field.normal_speed[i] * conormal[i];
+        }
       }
-    }
-    if (velocity.size() != mesh.n_vertices())
-      throw InputError(fmt::format("model '{}': {} velocities for {} vertices", model.name(), velocity.size(),
-                                   mesh.n_vertices()));
-    record.ms.velocity = clock.lap_ms();
-    if (options.on_state) options.on_state(StateView{mesh, n, t, d, &velocity, &field.point_fields});
-    record.ms.output = clock.lap_ms();
+      if (velocity.size() != mesh.n_vertices())
+        throw InputError(fmt::format("model '{}': {} velocities for {} vertices", model.name(), velocity.size(),
+                                     mesh.n_vertices()));
+      double step = remaining;
+      if (options.max_cfl > 0) {
+        // Equal sub-steps over what remains, each moving no point by more than max_cfl·h.
+        double vmax = 0;
+        for (const Vec3& v : velocity) vmax = std::max(vmax, v.norm());
+        const double reach = options.max_cfl * (options.cfl_length > 0 ? options.cfl_length : mean_edge_length(mesh));
+        const double ratio = vmax * remaining / reach;
+        if (ratio > 1 + 1e-9) step = remaining / std::ceil(ratio - 1e-9);  // 3.0000000000000004 is 3
+      }
+      record.ms.velocity += clock.lap_ms();
+      if (passes == 0) {  // the outputs and the model's statistics are those of the state T^n
+        if (options.on_state) options.on_state(StateView{mesh, n, t, d, &velocity, &field.point_fields});
+        metrics = std::move(field.metrics);
+        record.ms.output += clock.lap_ms();
+      }
 
-    // (2)(3) advect the signed distance.
-    AdvectionReport advection_report;
-    ScalarField phi_next = advect(mesh, d, velocity, dt, options.advection, &advection_report);
-    model.end_step(StepOutcome{mesh, d, phi_next, t, dt});
-    record.ms.advect = clock.lap_ms();
-    if (advection_report.lost > 0)
-      spdlog::warn("iteration {}: {} characteristics lost in advection", n, advection_report.lost);
+      // (2)(3) advect the signed distance.
+      AdvectionReport advection_report;
+      phi_next = advect(mesh, d, velocity, step, options.advection, &advection_report);
+      model.end_step(StepOutcome{mesh, d, phi_next, t + done, step});
+      record.ms.advect += clock.lap_ms();
+      if (advection_report.lost > 0)
+        spdlog::warn("iteration {}: {} characteristics lost in advection", n, advection_report.lost);
+      ++passes;
+      done = step == remaining ? dt : done + step;
+      // G vanished or fills S within the step: no front left to measure a distance to.
+      const auto [lowest, highest] = std::minmax_element(phi_next.begin(), phi_next.end());
+      if (done < dt && (*lowest >= 0 || *highest < 0)) break;
+    }
 
     // (4) cut the new interface into T^n and remesh: T^{n+1}.
+    Stopwatch clock;
     discretize(mesh, phi_next, options.discretize);
-    record.ms.discretize = clock.lap_ms();
+    record.ms.discretize += clock.lap_ms();
     remesh(mesh, options.remesh);
     if (options.canonical_order) canonicalize(mesh);
-    record.ms.remesh = clock.lap_ms();
+    record.ms.remesh += clock.lap_ms();
 
     ++n;
-    t += dt;
+    t += done;
     IterationRecord measured = measure_state(mesh, n, t);
     measured.dt = dt;
     measured.ms = record.ms;
-    measured.metrics = std::move(field.metrics);
-    clock.lap_ms();
+    measured.metrics = std::move(metrics);
+    measured.substeps = passes;
+    if (options.max_cfl > 0) measured.metrics.emplace_back("substeps", double(passes));
+    clock.lap_ms();  // the output callback's time
     if (options.on_iteration) options.on_iteration(mesh, measured);
     measured.ms.output += clock.lap_ms();
     if (options.log)
       spdlog::info("n={} t={:.5g} |G|={:.6g} |dG|={:.6g} comp={} faces={} qmin={:.3f} ms: vel {:.1f} dist {:.1f} "
-                   "adv {:.1f} disc {:.1f} remesh {:.1f} out {:.1f}",
+                   "adv {:.1f} disc {:.1f} remesh {:.1f} out {:.1f}{}",
                    n, t, measured.area, measured.interface_length, measured.components, measured.faces,
                    measured.min_quality, measured.ms.velocity, measured.ms.distance, measured.ms.advect,
-                   measured.ms.discretize, measured.ms.remesh, measured.ms.output);
+                   measured.ms.discretize, measured.ms.remesh, measured.ms.output,
+                   passes > 1 ? fmt::format(" ({} sub-steps)", passes) : std::string());
     result.records.push_back(std::move(measured));
   }
 

@@ -115,6 +115,18 @@ std::string Parameters::string(std::string_view key, std::string fallback) {
   return value->get();
 }
 
+std::filesystem::path Parameters::path(std::string_view key, std::string fallback) {
+  const bool present = has(key);
+  std::string text = string(key, std::move(fallback));
+  if (!present || text.empty()) return text;
+  std::filesystem::path name(text);
+  if (name.is_absolute()) return name.lexically_normal();
+  const auto& source = table_.get(key)->source();
+  // toml++ keeps the name given to parse_file, relative to the working directory of that call.
+  std::filesystem::path base = source.path ? std::filesystem::path(*source.path).parent_path() : std::filesystem::path();
+  return std::filesystem::absolute(base / name).lexically_normal();
+}
+
 std::string Parameters::choice(std::string_view key, std::string fallback, const std::vector<std::string>& allowed) {
   std::string value = string(key, std::move(fallback));
   if (std::find(allowed.begin(), allowed.end(), value) == allowed.end()) {

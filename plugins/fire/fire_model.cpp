@@ -72,8 +72,10 @@ class FireModel final : public VelocityModel {
       if (wind_.has_center) wind_.center = Vec3(center[0], center[1], 0);
       wind_.scale = w.number("scale", 1e-3);
       if (wind_.type == "grid") {
-        wind_.u = read_dem(w.string("u_file", ""));
-        wind_.v = read_dem(w.string("v_file", ""));
+        if (!w.has("u_file") || !w.has("v_file"))
+          throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
+        wind_.u = read_dem(w.path("u_file"));
+        wind_.v = read_dem(w.path("v_file"));
       } else {
         w.accept("u_file");
         w.accept("v_file");
@@ -82,7 +84,7 @@ class FireModel final : public VelocityModel {
     }
     if (const toml::table* fuel = p.table("fuel")) {
       Parameters f(*fuel, "model.fuel");
-      std::string map = f.string("map", "");
+      const std::filesystem::path map = f.path("map");
       std::vector<std::string> names;
       if (auto* arr = (*fuel)["presets"].as_array()) {
         f.accept("presets");
@@ -110,7 +112,7 @@ class FireModel final : public VelocityModel {
     if (const toml::table* arrival = p.table("arrival")) {
       Parameters a(*arrival, "model.arrival");
       arrival_cell_ = a.number("cell_size", 0, {.min = 0});
-      std::string like = a.string("like", "");
+      const std::filesystem::path like = a.path("like");
       if (!like.empty()) arrival_like_ = read_dem(like);
       a.reject_unknown();
     }

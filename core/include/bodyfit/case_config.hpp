@@ -58,6 +58,7 @@ struct RegionSpec {
 struct TimeSpec {
   double dt = 0;   ///< fixed time step (0: use cfl)
   double cfl = 0;  ///< Δt = cfl·h, h = remesh.hmax when given, else the mean edge length of T^0
+  double max_cfl = 0;  ///< sub-steps keep max|V|·Δt_sub ≤ max_cfl·h (0: off; EvolutionOptions::max_cfl)
   double final_time = std::numeric_limits<double>::infinity();
   long iterations = -1;  ///< −1: no limit (final_time decides)
 };
@@ -80,7 +81,7 @@ struct CaseConfig {
   TimeSpec time;
   DistanceOptions distance;
   AdvectionOptions advection;
-  DiscretizeOptions discretize;
+  DiscretizeOptions discretize{.snap_ratio = 0};  ///< no snapping by default (see EvolutionOptions)
   RemeshOptions remesh;            ///< `reference` is left empty: the driver sets it
   OutputSpec output;
   toml::table effective;           ///< the whole table after overrides (written as outdir/case.toml)

@@ -14,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -47,6 +48,12 @@ class Parameters {
                        std::int64_t max = std::numeric_limits<std::int64_t>::max());
   bool boolean(std::string_view key, bool fallback);
   std::string string(std::string_view key, std::string fallback);
+  /// A file name, resolved against the directory of the file the value was parsed from (a case
+  /// file read with toml::parse_file: `fuel = "maps/fuel.asc"` next to the case works from any
+  /// working directory). Absolute names are kept; a value with no source file (from `--set`, or
+  /// a table parsed from a string) resolves against the current working directory. The result is
+  /// absolute and lexically normal; `fallback` is returned as given when the key is absent.
+  std::filesystem::path path(std::string_view key, std::string fallback = "");
   /// A string among `allowed`.
   std::string choice(std::string_view key, std::string fallback, const std::vector<std::string>& allowed);
   /// An array of numbers; `size` (when given) is the required length.
