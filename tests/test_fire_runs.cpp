@@ -43,7 +43,8 @@ struct FireRun {
 
 // Burn disks (x, y, r in plan view) for `steps` steps of `dt` with the fire model configured by `toml_text`.
 FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disks, const std::string& toml_text,
-             double dt, int steps, const std::filesystem::path& output_dir = {}, double hausd = 0) {
+             double dt, int steps, const std::filesystem::path& output_dir = {}, double hausd = 0,
+             double max_cfl = 0) {
   ScalarField phi(surface.n_vertices());
   for (auto v : surface.vertices()) {
     double best = std::numeric_limits<double>::infinity();
@@ -65,6 +66,8 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   options.terrain = true;
   options.log = false;
   options.output_dir = output_dir;
+  options.max_cfl = max_cfl;
+  options.cfl_length = remesh.hmax;
   FireRun run;
   run.result = evolve(surface, model.model(), options);
   if (!output_dir.empty()) model->finish(output_dir);
@@ -129,6 +132,25 @@ TEST_CASE("inclined plane, no wind: the head runs uphill at R(alpha), the back a
   double head = (x_head - 700) / std::cos(alpha) - r0 / std::cos(alpha);
   double back = (700 - x_back) / std::cos(alpha) - r0 / std::cos(alpha);
   double head_exact = fire::rate_of_spread(alpha, p) * t, back_exact = p.R0 * t;
+  INFO("head " << head << " exact " << head_exact << "; back " << back << " exact " << back_exact);
+  CHECK(head == doctest::Approx(head_exact).epsilon(0.02));
+  CHECK(back == doctest::Approx(back_exact).epsilon(0.03));
+}
+
+TEST_CASE("CFL-capped sub-steps (max_cfl): the head still runs uphill at R(alpha), the back at R0") {
+  fire::BalbiParameters p;
+  const double alpha = 20 * kDeg, slope = std::tan(alpha);
+  const double r0 = 150, dt = 100, steps = 4;  // R(α)·Δt ≈ 6 edges per step: sub-steps of ≤ 1 edge
+  FireRun run = burn(inclined_plane(1600, 20, slope), {{700, 800, r0}}, "", dt, int(steps), {}, 0.05, 1.0);
+  REQUIRE(run.result.records.size() == std::size_t(steps));
+  for (const auto& record : run.result.records) CHECK(record.substeps >= 5);
+  double t = run.result.time;
+  auto [x_back, x_head] = front_x_extent(run.mesh);
+  double head = (x_head - 700) / std::cos(alpha) - r0 / std::cos(alpha);
+  double back = (700 - x_back) / std::cos(alpha) - r0 / std::cos(alpha);
+  double head_exact = fire::rate_of_spread(alpha, p) * t, back_exact = p.R0 * t;
+  MESSAGE("sub-steps " << run.result.records.front().substeps << ": head " << head << " exact " << head_exact
+                       << "; back " << back << " exact " << back_exact);
   INFO("head " << head << " exact " << head_exact << "; back " << back << " exact " << back_exact);
   CHECK(head == doctest::Approx(head_exact).epsilon(0.02));
   CHECK(back == doctest::Approx(back_exact).epsilon(0.03));
