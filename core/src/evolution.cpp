@@ -184,6 +184,8 @@ EvolutionResult evolve(SurfaceMesh& mesh, VelocityModel& model, const EvolutionO
         // Equal sub-steps over what remains, each moving no point by more than max_cfl·h.
         double vmax = 0;
         for (const Vec3& v : velocity) vmax = std::max(vmax, v.norm());
+        if (!std::isfinite(vmax))
+          throw InputError(fmt::format("model '{}': non-finite velocity (max_cfl cannot size the sub-steps)", model.name()));
         const double reach = options.max_cfl * (options.cfl_length > 0 ? options.cfl_length : mean_edge_length(mesh));
         const double ratio = vmax * remaining / reach;
         if (ratio > 1 + 1e-9) step = remaining / std::ceil(ratio - 1e-9);  // 3.0000000000000004 is 3

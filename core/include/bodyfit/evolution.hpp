@@ -69,7 +69,8 @@ struct EvolutionOptions {
   /// each recomputes d (from the advected φ, signed_distance) and V, then advects; the cut and the
   /// remesh happen once per step. The outputs, the history and the checkpoints stay one per step
   /// of `dt`; the model's compute() and end_step() are called per sub-step (StepContext::dt is
-  /// what remains of the step), its metrics are those of the first.
+  /// what remains of the step; the mesh, its regions and interface edges are those of T^n, the
+  /// distance and the conormal those of the moved front), its metrics are those of the first.
   double max_cfl = 0;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   double final_time = std::numeric_limits<double>::infinity();
