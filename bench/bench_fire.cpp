@@ -76,6 +76,17 @@ int plot_runs(const std::filesystem::path& outdir, const std::vector<std::filesy
     }
     area.push_back(a), perimeter.push_back(p);
   }
+  // Head room for the legend (top right): an invisible point (no label, no marker, no segment)
+  // raises the y range so the curves end below it.
+  for (auto* series : {&area, &perimeter}) {
+    double top = 0;
+    for (const auto& s : *series)
+      for (double y : s.y) top = std::max(top, y);
+    PlotSeries room;
+    room.x = {0.0}, room.y = {1.3 * top};
+    room.markers = false;
+    series->push_back(room);
+  }
   PlotOptions options;
   options.width = 640, options.height = 440;
   options.x_label = "time (min)";
