@@ -240,8 +240,12 @@ inline double pick(const double (&a)[3], int i) { return i == 0 ? a[0] : i == 1 
   double e[3] = {b[0] + d.d[0], b[1] + d.d[1], b[2] + d.d[2]};
   for (int crossing = 0; crossing < kMaxCrossings; ++crossing) {
     // An overshoot below the rounding level is not a crossing: a path running along an edge (a
-    // boundary edge in particular) stays on it instead of stepping out through rounding noise.
-    constexpr double overshoot = -1e-13;
+    // boundary edge in particular) stays on it instead of stepping out through rounding noise. The
+    // target's coordinates grow with the displacement over the face size (10⁵ for a long step
+    // through a 1e-6 face), and their rounding with them, amplified by the edge maps of a graded
+    // mesh: the level is relative to their size (a path within 1e-11 of the step's length from an
+    // edge runs along it).
+    const double overshoot = -1e-11 * (1 + std::max({std::abs(e[0]), std::abs(e[1]), std::abs(e[2])}));
     const bool reaches[3] = {e[0] < overshoot, e[1] < overshoot, e[2] < overshoot};
     if (!reaches[0] && !reaches[1] && !reaches[2]) {  // the target is in this face
       at.face = face;
@@ -342,11 +346,15 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
   const double cells = opt.max_cells_per_substep;
   for (int o = 0; o < outer; ++o) {
     double remaining = outer_dt;
-    double dt = 0;  // kept from one sub-step to the next while it still fits (no square root, no division)
+    // Kept from one sub-step to the next while it still fits (no square root, no division), and
+    // resized when it is too long or under half the local reach: a trace through a few tiny faces
+    // must not keep their tiny sub-steps for the rest of its time.
+    double dt = 0;
     while (remaining > 0) {
       const Delta k1 = velocity_at(s, x);
       const double speed2 = cells2(s, x.face, k1);  // in cells per unit time, squared
-      if (dt == 0 || speed2 * dt * dt > 1.5625 * cells * cells) {  // (1.25 cells)²
+      const double reach2 = speed2 * dt * dt;
+      if (dt == 0 || reach2 > 1.5625 * cells * cells || (reach2 < 0.25 * cells * cells && dt < remaining)) {
         // Equal sub-steps over what remains, each crossing about `cells` cells.
         dt = speed2 * remaining * remaining > cells * cells ? remaining / std::ceil(std::sqrt(speed2) * remaining / cells)
                                                             : remaining;
