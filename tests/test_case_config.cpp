@@ -286,3 +286,45 @@ TEST_CASE("Parameters::path resolves file names against the case file, --set val
   toml::table wrong = toml::parse("f = 3");
   CHECK_THROWS_AS(Parameters(wrong).path("f"), InputError);
 }
+
+TEST_CASE("terrains: ridge detection is off unless [remesh] angle is given, and the remesher then keeps quality") {
+  const std::string terrain = R"(
+[surface]
+generator = "terrain"
+extent = 20000.0
+h = 400.0
+seed = 7
+max_height = 3000.0
+feature_size = 3000.0
+
+[region]
+shape = "disks"
+centers = [[10000.0, 10000.0]]
+radii = [2000.0]
+
+[model]
+name = "conormal"
+
+[time]
+dt = 60.0
+iterations = 1
+
+[remesh]
+hmax = 400.0
+)";
+  const CaseSetup off = setup_case(parse(terrain));
+  CHECK(off.options.remesh.feature_angle == 0);
+  const CaseSetup given = setup_case(parse(terrain, {"remesh.angle=45.0"}));
+  CHECK(given.options.remesh.feature_angle == 45);
+  // On this steep landscape the 45° ridges freeze the remesh: fewer good triangles with them.
+  auto share_good = [](const SurfaceMesh& mesh) {
+    std::size_t good = 0;
+    for (auto f : mesh.faces()) good += face_quality(mesh, f) >= 0.3;
+    return double(good) / double(mesh.n_faces());
+  };
+  MESSAGE("share of faces with q ≥ 0.3: ridges off " << share_good(off.mesh) << ", 45° ridges " << share_good(given.mesh));
+  CHECK(share_good(off.mesh) > share_good(given.mesh));
+  CHECK(share_good(off.mesh) > 0.99);
+  // Spheres keep the default.
+  CHECK(setup_case(parse(kValidCase)).options.remesh.feature_angle == 45);
+}

@@ -386,6 +386,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     out.hmax = s.positive("hmax", out.hmax);
     out.hausd = s.positive("hausd", out.hausd);
     out.hgrad = s.positive("hgrad", out.hgrad);
+    config.remesh_angle_given = s.has("angle");
     out.feature_angle = s.number("angle", out.feature_angle);
     out.max_passes = int(s.integer("max_passes", out.max_passes));
     out.incremental = s.boolean("incremental", out.incremental);
@@ -499,6 +500,10 @@ CaseSetup setup_case(const CaseConfig& config) {
   mesh.garbage_collection();
   EvolutionOptions& options = setup.options;
   options.remesh = config.remesh;
+  // A landscape has no sharp features: on steep terrain many lattice edges exceed the 45° dihedral
+  // angle, and ridges detected there froze the remesher (minimum quality 0.06 instead of 0.6 on
+  // the fire cases). Feature detection stays off for terrains unless [remesh] angle is given.
+  if (config.surface.kind == SurfaceSpec::Kind::Terrain && !config.remesh_angle_given) options.remesh.feature_angle = 0;
   options.remesh.reference = make_case_reference(config, mesh);
   if (config.region.kind == RegionSpec::Kind::Refs) {
     label_from_refs(config, mesh);

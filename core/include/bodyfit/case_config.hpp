@@ -83,6 +83,7 @@ struct CaseConfig {
   AdvectionOptions advection;
   DiscretizeOptions discretize{.snap_ratio = 0};  ///< no snapping by default (see EvolutionOptions)
   RemeshOptions remesh;            ///< `reference` is left empty: the driver sets it
+  bool remesh_angle_given = false; ///< [remesh] angle set explicitly (else off on terrains)
   OutputSpec output;
   toml::table effective;           ///< the whole table after overrides (written as outdir/case.toml)
 };
