@@ -9,11 +9,12 @@
 // rule (a zero-length step crosses to the next face), so no characteristic is ever dropped.
 //
 // Tangent vectors are moved between faces by the same unfoldings: RK4 carries each stage's
-// velocity back to the start face along the crossed edges; RK2 carries its first half-step forward
-// to the midpoint (the walk returns the displacement carried) and continues walking from there.
+// velocity back to the start face along the crossed edges; RK2 takes the midpoint velocity from
+// the affine field of the current face, so each of its sub-steps is a single walk.
 //
-// Faces are stored, and vertices traced, in Z-order so that neighbouring characteristics read
-// neighbouring memory; each trace is independent, so the result does not depend on the threads.
+// Vertices are traced in Z-order and faces stored in the order of their first corner in it, so
+// that neighbouring characteristics read neighbouring memory; each trace is independent, so the
+// result does not depend on the threads.
 #include <bodyfit/advection.hpp>
 
 #include <bodyfit/error.hpp>
@@ -74,9 +75,6 @@ struct Delta {
 inline Delta operator*(double s, const Delta& a) { return {{s * a.d[0], s * a.d[1], s * a.d[2]}}; }
 inline Delta operator+(const Delta& a, const Delta& b) {
   return {{a.d[0] + b.d[0], a.d[1] + b.d[1], a.d[2] + b.d[2]}};
-}
-inline Delta operator-(const Delta& a, const Delta& b) {
-  return {{a.d[0] - b.d[0], a.d[1] - b.d[1], a.d[2] - b.d[2]}};
 }
 
 struct Surface {

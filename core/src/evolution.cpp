@@ -99,14 +99,14 @@ void put_vertex(Bytes& out, const SurfaceMesh& mesh, VertexHandle v) {
   out.put<double>(mesh.phi(v));
 }
 
-VertexHandle get_vertex(Cursor& in, SurfaceMesh& mesh) {
+/// The fields put_vertex wrote, into the existing vertex v.
+void get_vertex(Cursor& in, SurfaceMesh& mesh, VertexHandle v) {
   const double x = in.get<double>(), y = in.get<double>(), z = in.get<double>();
-  const VertexHandle v = mesh.new_vertex(Vec3(x, y, z));
+  mesh.set_point(v, Vec3(x, y, z));
   mesh.vertex_ref(v) = in.get<std::int32_t>();
   mesh.corner(v) = in.get<char>();
   mesh.required(v) = in.get<char>();
   mesh.phi(v) = in.get<double>();
-  return v;
 }
 
 void put_edge_tags(Bytes& out, const SurfaceMesh& mesh, EdgeHandle e) {
@@ -128,7 +128,7 @@ SurfaceMesh read_v1(Cursor& in, std::uint64_t nv, std::uint64_t nf) {
   SurfaceMesh mesh;
   mesh.reserve(nv, nv + nf + 16, nf);
   std::vector<VertexHandle> vertices(nv);
-  for (std::uint64_t i = 0; i < nv; ++i) vertices[i] = get_vertex(in, mesh);
+  for (std::uint64_t i = 0; i < nv; ++i) get_vertex(in, mesh, vertices[i] = mesh.new_vertex(Vec3(0, 0, 0)));
   for (std::uint64_t i = 0; i < nf; ++i) {
     const int a = in.index(nv, "vertex"), b = in.index(nv, "vertex"), c = in.index(nv, "vertex");
     const auto f = mesh.add_face(vertices[a], vertices[b], vertices[c]);
@@ -155,12 +155,7 @@ SurfaceMesh read_v2(Cursor& in, std::uint64_t nv, std::uint64_t ne, std::uint64_
   const std::uint64_t nh = 2 * ne;
   for (std::uint64_t i = 0; i < nv; ++i) {
     const VertexHandle v{int(i)};
-    const double x = in.get<double>(), y = in.get<double>(), z = in.get<double>();
-    mesh.set_point(v, Vec3(x, y, z));
-    mesh.vertex_ref(v) = in.get<std::int32_t>();
-    mesh.corner(v) = in.get<char>();
-    mesh.required(v) = in.get<char>();
-    mesh.phi(v) = in.get<double>();
+    get_vertex(in, mesh, v);
     mesh.set_halfedge_handle(v, HalfedgeHandle(in.index(nh, "halfedge", true)));
   }
   for (std::uint64_t e = 0; e < ne; ++e) {
