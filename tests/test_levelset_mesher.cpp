@@ -586,3 +586,67 @@ TEST_CASE("the quad of a two-crossing cut gets the diagonal whose worse triangle
     CHECK(interface_length(mesh) == doctest::Approx((P - Q).norm()).epsilon(1e-14));
   }
 }
+
+TEST_CASE("vertices the remesher cannot move snap with fixed_snap_ratio, free vertices do not") {
+  const int n = 16;
+  const double h = 1.0 / n;
+  // A vertical line 1e-3·h right of the column x = 0.5: it passes a hair from the two boundary
+  // vertices (0.5, 0) and (0.5, 1) and from the 15 interior vertices between them.
+  auto phi_of = [&](const Vec3& p) { return p[0] - 0.5 - 1e-3 * h; };
+  auto on_column = [&](const Vec3& p) { return std::abs(p[0] - 0.5) < 1e-12; };
+  for (double fixed : {0.05, 0.0}) {
+    CAPTURE(fixed);
+    SurfaceMesh mesh = make_square(n);
+    const std::size_t n0 = mesh.n_vertices();
+    auto report = discretize(mesh, sample(mesh, phi_of), {.snap_ratio = 0, .fixed_snap_ratio = fixed});
+    require_valid(mesh, strict(1, 1));
+    CHECK(report.snapped_vertices == (fixed > 0 ? 2u : 0u));
+    for (std::size_t i = 0; i < n0; ++i) {
+      const VertexHandle v{int(i)};
+      if (!on_column(mesh.point(v))) continue;
+      const bool boundary = mesh.is_boundary(v);
+      CHECK((mesh.phi(v) == 0) == (boundary && fixed > 0));
+    }
+    // The interface still runs from boundary to boundary as one curve.
+    CHECK(interface_curves(mesh).open == 1);
+  }
+}
+
+TEST_CASE("specks: parts of a region below speck_area·h² go to the region around them") {
+  const int n = 32;
+  const double h = 1.0 / n, r = 0.2;
+  const Vec3 centre(0.5, 0.5, 0);
+  // A disk, an inside island of a fraction of a cell far from it, and a hole of the same size in
+  // the disk: without speck removal three interface curves, with it one.
+  // Each is a disk of radius 0.15 h centred 0.05 h from a vertex: only that vertex changes sign,
+  // and the cut around it encloses 0.06 h² (h the mean edge length).
+  const Vec3 island(27 * h + 0.04 * h, 5 * h + 0.03 * h, 0), hole(16 * h + 0.04 * h, 16 * h + 0.03 * h, 0);
+  const double speck = 0.15 * h;
+  auto phi_of = [&](const Vec3& p) {
+    double disk = (p - centre).norm() - r;
+    double speck_in = (p - island).norm() - speck, speck_out = speck - (p - hole).norm();
+    return std::min(std::max(disk, speck_out), speck_in);
+  };
+  SurfaceMesh kept = make_square(n);
+  auto kept_report = discretize(kept, sample(kept, phi_of), {.speck_area = 0});
+  require_valid(kept, strict(1, 1));
+  CHECK(kept_report.removed_specks == 0);
+  CHECK(interface_curves(kept).closed == 3);
+
+  SurfaceMesh mesh = make_square(n);
+  auto report = discretize(mesh, sample(mesh, phi_of), {.speck_area = 0.1});
+  require_valid(mesh, strict(1, 1));
+  CHECK(report.removed_specks == 2);
+  CHECK(interface_curves(mesh).closed == 1);
+  CHECK(region_components(mesh, kInside) == 1);
+  CHECK(region_components(mesh, kOutside) == 1);
+  // Each speck was under 0.1 h²: the inside area moves by less than that per speck.
+  CHECK(std::abs(region_area(mesh, kInside) - region_area(kept, kInside)) < 2 * 0.1 * h * h);
+  // φ agrees with the labels: negative only where a face is inside.
+  for (auto v : mesh.vertices()) {
+    bool inside_face = false, outside_face = false;
+    for (auto f : mesh.vf_range(v)) (mesh.region(f) == kInside ? inside_face : outside_face) = true;
+    if (!outside_face) CHECK(mesh.phi(v) <= 0);
+    if (!inside_face) CHECK(mesh.phi(v) >= 0);
+  }
+}

@@ -46,6 +46,15 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
                   "put a vertex on the level set when the crossing is closer than this fraction of the edge")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--snap-fixed", cut->fixed_snap_ratio,
+                  "the same for vertices the remesher cannot move (boundary, ridges, corners, required); "
+                  "the larger of the two applies")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 0.5));
+  cmd->add_option("--speck", cut->speck_area,
+                  "give parts of a region smaller than this many h² (h: mean edge length) to the region around them")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   bodyfit::cli::add_remesh_options(*cmd, *options);
   cmd->add_flag("--no-remesh", *no_remesh, "only cut the level set in (thin triangles remain)");
   return {cmd, [=]() {
@@ -58,10 +67,10 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
             double cut_ms = clock.lap();
             auto quality = bodyfit::quality_stats(mesh);
             spdlog::info("discretize: {} -> {} faces, {} crossed edges, {} snapped and {} separated vertices, "
-                         "{} flipped diagonals; {} interface edges, {} inside faces; quality min {:.3g} mean {:.3f}; "
+                         "{} flipped diagonals, {} specks removed; {} interface edges, {} inside faces; quality min {:.3g} mean {:.3f}; "
                          "{:.1f} ms (read {:.1f} ms)",
                          faces_before, mesh.n_faces(), report.crossed_edges, report.snapped_vertices,
-                         report.separated_vertices, report.flipped_diagonals, report.interface_edges,
+                         report.separated_vertices, report.flipped_diagonals, report.removed_specks, report.interface_edges,
                          report.inside_faces, quality.min, quality.mean, cut_ms, read_ms);
             if (!*no_remesh) {
               auto remeshed = bodyfit::remesh(mesh, *options);

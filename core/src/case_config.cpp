@@ -377,6 +377,11 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     config.discretize.snap_ratio = s.number("snap_ratio", config.discretize.snap_ratio);
     if (!(config.discretize.snap_ratio >= 0 && config.discretize.snap_ratio < 0.5))
       s.fail("snap_ratio: must be in [0, 0.5)");
+    config.discretize.fixed_snap_ratio = s.number("fixed_snap_ratio", config.discretize.fixed_snap_ratio);
+    if (!(config.discretize.fixed_snap_ratio >= 0 && config.discretize.fixed_snap_ratio < 0.5))
+      s.fail("fixed_snap_ratio: must be in [0, 0.5)");
+    config.discretize.speck_area = s.number("speck_area", config.discretize.speck_area);
+    if (!(config.discretize.speck_area >= 0)) s.fail("speck_area: must be ≥ 0");
     s.check_unknown();
   }
   {  // [remesh]

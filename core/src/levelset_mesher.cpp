@@ -78,18 +78,25 @@ struct QuadCut {
   int edge_ab = -1, edge_ca = -1;
 };
 
-/// Snap the vertices whose crossing lies within snap_ratio of them (in index order, so the result
+/// Snap the vertices whose crossing lies within their snap ratio of them (in index order, so the result
 /// does not depend on anything but the input), keeping every φ = 0 vertex a simple interface point.
-void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, ScalarField& value, double snap_ratio,
-          DiscretizeReport& report) {
-  if (snap_ratio <= 0) return;
+void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, ScalarField& value,
+          const DiscretizeOptions& options, DiscretizeReport& report) {
+  const double fixed_ratio = std::max(options.snap_ratio, options.fixed_snap_ratio);
+  if (fixed_ratio <= 0) return;
+  // The remesher cannot move these vertices away from a cut next to them.
+  auto ratio = [&](VertexHandle v) {
+    bool fixed = mesh.is_boundary(v) || mesh.corner(v) || mesh.required(v);
+    for (auto e : mesh.ve_range(v)) fixed = fixed || mesh.ridge(e) || mesh.required(e);
+    return fixed ? fixed_ratio : options.snap_ratio;
+  };
   std::vector<int> candidates;
   for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
-    int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-    double t = zero_fraction(value[a], value[b]);
-    if (t < snap_ratio) candidates.push_back(a);
-    if (1 - t < snap_ratio) candidates.push_back(b);
+    auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);
+    double t = zero_fraction(value[a.idx()], value[b.idx()]);
+    if (t < fixed_ratio && t < ratio(a)) candidates.push_back(a.idx());
+    if (1 - t < fixed_ratio && 1 - t < ratio(b)) candidates.push_back(b.idx());
   }
   std::sort(candidates.begin(), candidates.end());
   candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
@@ -100,6 +107,7 @@ void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, Scala
     double old = value[index];
     // A neighbour snapped earlier may have removed the close crossing.
     bool still_close = false;
+    const double snap_ratio = ratio(v);
     for (auto w : mesh.vv_range(v)) {
       double vw = value[w.idx()];
       if (opposite_signs(old, vw) && zero_fraction(old, vw) < snap_ratio) still_close = true;
@@ -185,6 +193,72 @@ bool improve_diagonal(SurfaceMesh& mesh, VertexHandle p, VertexHandle b, VertexH
   return true;
 }
 
+/// Give every part of a region with area below `min_area` to the region around it (smallest
+/// first; a part next to one given away in the same round waits for the next round, so that a
+/// speck's hole is judged after the speck is gone). Returns how many parts were given away.
+std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area) {
+  std::size_t removed = 0;
+  const int nf = int(mesh.n_faces());
+  std::vector<int> part(std::size_t(nf), -1);
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::fill(part.begin(), part.end(), -1);
+    std::vector<double> area;
+    std::vector<FaceHandle> stack;
+    for (int i = 0; i < nf; ++i) {
+      if (part[std::size_t(i)] >= 0) continue;
+      const int id = int(area.size());
+      area.push_back(0);
+      part[std::size_t(i)] = id;
+      stack.push_back(FaceHandle(i));
+      while (!stack.empty()) {
+        auto f = stack.back();
+        stack.pop_back();
+        area[std::size_t(id)] += face_area(mesh, f);
+        for (auto g : mesh.ff_range(f))
+          if (part[std::size_t(g.idx())] < 0 && mesh.region(g) == mesh.region(f)) {
+            part[std::size_t(g.idx())] = id;
+            stack.push_back(g);
+          }
+      }
+    }
+    std::vector<int> order;
+    for (int id = 0; id < int(area.size()); ++id)
+      if (area[std::size_t(id)] < min_area) order.push_back(id);
+    if (order.empty() || area.size() < 2) break;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return area[std::size_t(a)] < area[std::size_t(b)]; });
+    std::vector<int> slot(area.size(), -1);  // small part -> its faces
+    std::vector<std::vector<FaceHandle>> faces(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) slot[std::size_t(order[k])] = int(k);
+    for (int i = 0; i < nf; ++i)
+      if (int k = slot[std::size_t(part[std::size_t(i)])]; k >= 0) faces[std::size_t(k)].push_back(FaceHandle(i));
+    std::vector<char> flipped(area.size(), 0), blocked(area.size(), 0);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      if (blocked[std::size_t(order[k])]) continue;
+      flipped[std::size_t(order[k])] = 1;
+      for (auto f : faces[k])
+        for (auto g : mesh.ff_range(f)) blocked[std::size_t(part[std::size_t(g.idx())])] = 1;
+      ++removed;
+      changed = true;
+    }
+    for (int i = 0; i < nf; ++i) {
+      if (!flipped[std::size_t(part[std::size_t(i)])]) continue;
+      FaceHandle f(i);
+      const bool to_inside = mesh.region(f) != kInside;
+      mesh.region(f) = to_inside ? kInside : kOutside;
+      // φ takes the sign of its new side (its zeros become a hair off zero).
+      for (auto v : mesh.fv_range(f)) {
+        double& x = value[std::size_t(v.idx())];
+        double magnitude = std::max(std::abs(x), 1e-12 * std::sqrt(min_area));
+        bool all_same = true;
+        for (auto g : mesh.vf_range(v)) all_same = all_same && (mesh.region(g) == kInside) == to_inside;
+        if (all_same) x = to_inside ? -magnitude : magnitude;
+      }
+    }
+  }
+  return removed;
+}
+
 }  // namespace
 
 DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options) {
@@ -193,6 +267,7 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     throw InputError("discretize: the level set has " + std::to_string(phi.size()) + " values for " +
                      std::to_string(mesh.n_vertices()) + " vertices");
   ScalarField value = phi;
+  const double h_input = options.speck_area > 0 ? edge_length_stats(mesh).mean : 0;
   for (auto v : mesh.vertices())
     if (!std::isfinite(value[v.idx()]))
       throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
@@ -201,7 +276,7 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   std::vector<EdgeHandle> crossed;
   for (auto e : mesh.edges())
     if (crossed_edge(mesh, value, e)) crossed.push_back(e);
-  snap(mesh, crossed, value, options.snap_ratio, report);
+  snap(mesh, crossed, value, options, report);
   auto separated = separate_pinches(mesh, value, report);
   std::erase_if(crossed, [&](EdgeHandle e) { return !crossed_edge(mesh, value, e); });
   if (!separated.empty()) {
@@ -293,8 +368,9 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     bool inside = value[mesh.to_vertex_handle(h).idx()] < 0 || value[mesh.to_vertex_handle(h1).idx()] < 0 ||
                   value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
-    report.inside_faces += inside;
   }
+  if (options.speck_area > 0) report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input);
+  for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
   for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
 
   // The interface: exactly the edges between faces of different labels (as

@@ -14,6 +14,12 @@ struct DiscretizeOptions {
   /// the vertex does not move) instead of inserting a point next to it, which would leave a sliver.
   /// A snap that would make the interface touch itself at a vertex is not done. 0 disables snapping.
   double snap_ratio = 0.05;
+  /// The same rule for the vertices the remesher cannot move (on the boundary, on a ridge or a
+  /// required edge, corners, required vertices), with the larger of the two ratios: a cut passing
+  /// next to such a vertex leaves a sliver that no relocation can open, whereas a free vertex is
+  /// moved away by the remesher. This is what keeps the interface clean where a front meets the
+  /// boundary when snap_ratio is 0 (as in evolutions).
+  double fixed_snap_ratio = 0.05;
   /// Where a crossed edge is cut. true: at the zero of the cubic Hermite interpolant of φ along the
   /// edge, whose end slopes come from the vertex gradients of φ (vertex_gradient): φ is a smooth
   /// function sampled at the vertices, and the linear zero is off the true level set by
@@ -22,6 +28,12 @@ struct DiscretizeOptions {
   /// the edge; otherwise, and when false, the zero of the linear interpolant (the paper's and
   /// mmgs's rule; exact for φ affine along the edge, where both agree).
   bool hermite_crossings = true;
+  /// Specks: a connected part of either region whose area is below speck_area·h² (h the mean edge
+  /// length of the input mesh) is given to the region around it, so its interface disappears.
+  /// Such a part is below what the mesh resolves (a noise-born island of φ a fraction of one
+  /// triangle across) and, as the remesher never changes the topology of the regions, it would pin
+  /// a cluster of poor triangles. 0 keeps every part.
+  double speck_area = 0;
 };
 
 struct DiscretizeReport {
@@ -40,6 +52,7 @@ struct DiscretizeReport {
   /// Vertices where the interface is still not a simple curve on return (interface-degree other
   /// than 0 or 2, or more than 1 on the boundary). Always 0; kept as a self-check.
   std::size_t pinched_vertices = 0;
+  std::size_t removed_specks = 0;     ///< parts of a region given to the region around them (speck_area)
 };
 
 /// Cut the zero level set of `phi` (one value per vertex index) into `mesh`. Previous interface
