@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <queue>
 #include <vector>
 
@@ -23,8 +24,10 @@ namespace {
 
 // Kinds of feature curves an edge can belong to (the label of the reference polyline).
 constexpr char kNoCurve = 0, kInterfaceCurve = 1, kRidgeCurve = 2, kBoundaryCurve = 3, kRequiredCurve = 4;
-// Vertex kinds: free on S, sliding along one feature curve, locked.
-constexpr char kFreeVertex = 0, kCurveVertex = 1, kLockedVertex = 2;
+// Vertex kinds: free on S, sliding along one feature curve, a corner of one curve (it turns by
+// more than the corner angle there: it does not move, but may merge with a curve neighbour closer
+// than hausd), locked (curve ends and junctions, required, isolated).
+constexpr char kFreeVertex = 0, kCurveVertex = 1, kLockedVertex = 2, kCornerVertex = 3;
 
 // Edge length window relative to the target size (as MMG's metric lengths): split above √2,
 // collapse below 1/√2, so that a mesh whose edges are within ±30 % of the target is left alone.
@@ -38,6 +41,16 @@ constexpr double kAcceptQuality = 0.4;
 constexpr double kCurveRepairQuality = 0.6;
 // Flips are tried only when the worse triangle of the pair is below this quality.
 constexpr double kFlipBelow = 0.75;
+// Below this quality a triangle's normal says little about S: moves are checked against the
+// vertex normal instead.
+constexpr double kReliableNormal = 1e-3;
+// A flip's two new triangles must be within 20° of the mean vertex normal (within 45° for repairs,
+// the bound of collapses and moves).
+constexpr double kFlipFlatness = 0.9396926207859084, kRepairFlatness = 0.7;
+// Triangles still below this quality after the passes go to the sliver repair, for at most
+// kRepairRounds sweeps.
+constexpr double kRepairBelow = 0.3;
+constexpr int kRepairRounds = 5;
 // Relocation spreads at most this many rings away from a topological change or a bad element.
 constexpr char kSmoothRings = 3;
 // A relocation moving a vertex by more than this fraction of its size re-queues its ring.
@@ -59,6 +72,12 @@ Tri triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
   }
   return t;
 }
+
+// What a candidate local operation does to the triangles it changes: their worst (and summed)
+// quality before and after.
+struct Change {
+  double old_min = 1, new_min = 1, old_sum = 0, new_sum = 0;
+};
 
 class Remesher {
  public:
@@ -113,9 +132,23 @@ class Remesher {
 
   bool split(EdgeHandle e);
   bool collapse(EdgeHandle e);
-  bool collapse_check(HalfedgeHandle h, double& min_quality) const;
+  bool collapse_check(HalfedgeHandle h, Change& change) const;
+  bool curve_collapse_within_hausd(HalfedgeHandle h) const;
+  void collapse_halfedge(HalfedgeHandle h);
   bool flip(EdgeHandle e);
+  bool flip_check(EdgeHandle e, Change& change, double min_cos = kFlipFlatness) const;
+  void flip_edge(EdgeHandle e);
   double relocate(VertexHandle v);
+  bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
+  bool move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const;
+  void move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp);
+  void repair_slivers();
+  bool repair(FaceHandle f);
+  std::optional<std::pair<VertexHandle, VertexHandle>> curve_neighbours(VertexHandle v) const;
+  double face_quality(FaceHandle f) const {
+    auto p = face_points(m_, f);
+    return triangle(p[0], p[1], p[2]).quality;
+  }
 
   Vec3 project_on_curve(const Vec3& p, char curve) const { return curves_.closest(p, curve); }
 
@@ -181,7 +214,7 @@ void Remesher::classify_features() {
     VertexHandle v(i);
     int count = 0;
     char type = kNoCurve;
-    bool mixed = false, locked = m_.required(v) || m_.corner(v);
+    bool mixed = false, locked = m_.required(v) || m_.corner(v), angle_corner = false;
     Vec3 dir[2];
     for (auto h : m_.voh_range(v)) {
       char c = m_.property(ecurve_, m_.edge_handle(h));
@@ -194,14 +227,16 @@ void Remesher::classify_features() {
     }
     if (m_.is_isolated(v)) locked = true;
     if (count != 0 && count != 2) locked = true;
-    if (count == 2 && !locked && !mixed) {
+    // The interface is the zero set of a sampled φ: its turns at the scale of fresh cuts are noise,
+    // so it has no angle corners; collapses along it are bounded by hausd instead (collapse_check).
+    if (count == 2 && !locked && !mixed && type != kInterfaceCurve) {
       double n0 = dir[0].norm(), n1 = dir[1].norm();
       // Turning angle between the two curve edges: π − angle(d0, d1).
       double c = n0 > 0 && n1 > 0 ? -(dir[0] | dir[1]) / (n0 * n1) : -1;
-      if (std::acos(std::clamp(c, -1.0, 1.0)) > corner_angle_) locked = true;
+      angle_corner = std::acos(std::clamp(c, -1.0, 1.0)) > corner_angle_;
     }
     if (mixed) locked = true;
-    m_.property(kind_, v) = locked ? kLockedVertex : (count == 2 ? kCurveVertex : kFreeVertex);
+    m_.property(kind_, v) = locked ? kLockedVertex : angle_corner ? kCornerVertex : (count == 2 ? kCurveVertex : kFreeVertex);
     m_.property(vcurve_, v) = count == 2 ? type : kNoCurve;
     Vec3 normal(0, 0, 0);
     int hint = -1;
@@ -442,14 +477,31 @@ bool Remesher::split(EdgeHandle e) {
   return true;
 }
 
+// Whether the curve stays within hausd of the curve vertex v0 when it collapses along h onto v1:
+// the new curve edge (u, v1), u the other curve neighbour of v0, must pass within hausd of v0.
+bool Remesher::curve_collapse_within_hausd(HalfedgeHandle h) const {
+  auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
+  char curve = m_.property(vcurve_, v0);
+  for (auto hu : m_.voh_range(v0)) {
+    auto u = m_.to_vertex_handle(hu);
+    if (u == v1 || m_.property(ecurve_, m_.edge_handle(hu)) != curve) continue;
+    const Vec3 &a = m_.point(u), &b = m_.point(v1), &p = m_.point(v0);
+    Vec3 ab = b - a;
+    double t = ab.sqrnorm() > 0 ? std::clamp(((p - a) | ab) / ab.sqrnorm(), 0.0, 1.0) : 0.0;
+    if ((a + ab * t - p).norm() > hausd_) return false;
+  }
+  return true;
+}
+
 // Whether collapsing h (its from-vertex v0 onto its to-vertex v1) keeps features, topology and
-// geometry; min_quality receives the worst new triangle.
-bool Remesher::collapse_check(HalfedgeHandle h, double& min_quality) const {
+// geometry (no fold, no edge made too long); `change` receives the qualities of v0's star.
+bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
   auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
   auto e = m_.edge_handle(h);
   char kind = m_.property(kind_, v0);
   if (kind == kLockedVertex) return false;
-  if (kind == kCurveVertex && m_.property(ecurve_, e) != m_.property(vcurve_, v0)) return false;
+  if ((kind == kCurveVertex || kind == kCornerVertex) && m_.property(ecurve_, e) != m_.property(vcurve_, v0)) return false;
+  if (kind == kCornerVertex && length(e) > hausd_) return false;
   if (kind == kFreeVertex && m_.property(ecurve_, e) != kNoCurve) return false;
   // Two feature edges of a triangle cannot be merged into one.
   for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
@@ -459,6 +511,7 @@ bool Remesher::collapse_check(HalfedgeHandle h, double& min_quality) const {
     if (m_.property(ecurve_, e0) != kNoCurve && m_.property(ecurve_, e1) != kNoCurve) return false;
   }
   if (!const_cast<SurfaceMesh&>(m_).is_collapse_ok(h)) return false;
+  if ((kind == kCurveVertex || kind == kCornerVertex) && !curve_collapse_within_hausd(h)) return false;
   const Vec3& p1 = m_.point(v1);
   double old_min = 1, new_min = 1;
   for (auto f : m_.vf_range(v0)) {
@@ -472,25 +525,32 @@ bool Remesher::collapse_check(HalfedgeHandle h, double& min_quality) const {
     for (int k = 0; k < 3; ++k)
       if (vs[k] == v0) pts[k] = p1;
     auto t = triangle(pts[0], pts[1], pts[2]);
-    Vec3 n_old = old_tri.quality > 1e-3 ? old_tri.normal : m_.property(vnormal_, v0);
+    Vec3 n_old = old_tri.quality > kReliableNormal ? old_tri.normal : m_.property(vnormal_, v0);
     if ((t.normal | n_old) < 0.7) return false;
     new_min = std::min(new_min, t.quality);
   }
-  if (new_min < std::min(kAcceptQuality, old_min)) return false;
   for (auto w : m_.vv_range(v0)) {
     if (w == v1) continue;
-    if ((m_.point(w) - p1).norm() > kSplitRatio * target(v1, w)) return false;
+    // No edge too long, unless it was already (the split pass deals with it).
+    double l = (m_.point(w) - p1).norm();
+    if (l > kSplitRatio * target(v1, w) && l > (m_.point(w) - m_.point(v0)).norm()) return false;
   }
-  min_quality = new_min;
+  change.old_min = old_min;
+  change.new_min = new_min;
   return true;
 }
 
 bool Remesher::collapse(EdgeHandle e) {
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
-  double q0 = -1, q1 = -1;
-  bool ok0 = collapse_check(h0, q0), ok1 = collapse_check(h1, q1);
+  Change c0, c1;
+  auto acceptable = [](const Change& c) { return c.new_min >= std::min(kAcceptQuality, c.old_min); };
+  bool ok0 = collapse_check(h0, c0) && acceptable(c0), ok1 = collapse_check(h1, c1) && acceptable(c1);
   if (!ok0 && !ok1) return false;
-  auto h = (ok0 && (!ok1 || q0 >= q1)) ? h0 : h1;
+  collapse_halfedge((ok0 && (!ok1 || c0.new_min >= c1.new_min)) ? h0 : h1);
+  return true;
+}
+
+void Remesher::collapse_halfedge(HalfedgeHandle h) {
   auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
   // The edges (v0, vl) and (v1, vl) of each removed triangle merge: keep the union of their tags.
   struct Merge {
@@ -521,38 +581,49 @@ bool Remesher::collapse(EdgeHandle e) {
   }
   ++report_.collapses;
   mark_ring(v1);
-  return true;
 }
 
 bool Remesher::flip(EdgeHandle e) {
+  Change change;
+  // Only pairs with a poor triangle are worth changing: a good mesh stays as it is.
+  if (!flip_check(e, change) || change.old_min >= kFlipBelow || change.new_min <= change.old_min + 1e-3) return false;
+  flip_edge(e);
+  return true;
+}
+
+// Whether flipping e keeps the pair flat on S; `change` receives the qualities of the two pairs.
+bool Remesher::flip_check(EdgeHandle e, Change& change, double min_cos) const {
   if (m_.property(ecurve_, e) != kNoCurve || m_.is_boundary(e)) return false;
-  if (!m_.is_flip_ok(e)) return false;
+  if (!const_cast<SurfaceMesh&>(m_).is_flip_ok(e)) return false;
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
   auto a = m_.from_vertex_handle(h0), b = m_.to_vertex_handle(h0);
   auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h0));
   auto d = m_.to_vertex_handle(m_.next_halfedge_handle(h1));
   const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
-  double q_old = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
   auto t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
-  double q_new = std::min(t0.quality, t1.quality);
-  // Only pairs with a poor triangle are worth changing: a good mesh stays as it is.
-  if (q_old >= kFlipBelow || q_new <= q_old + 1e-3) return false;
   // The new pair must lie flat on S (no fold, no shortcut across curvature).
   Vec3 n = m_.property(vnormal_, a) + m_.property(vnormal_, b) + m_.property(vnormal_, c) + m_.property(vnormal_, d);
   double len = n.norm();
   if (len <= 0) return false;
   n /= len;
-  constexpr double kCos20 = 0.9396926207859084;
-  if ((t0.normal | n) < kCos20 || (t1.normal | n) < kCos20) return false;
+  if ((t0.normal | n) < min_cos || (t1.normal | n) < min_cos) return false;
+  change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+  change.new_min = std::min(t0.quality, t1.quality);
+  return true;
+}
+
+void Remesher::flip_edge(EdgeHandle e) {
+  auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+  VertexHandle quad[4] = {m_.from_vertex_handle(h0), m_.to_vertex_handle(h0),
+                          m_.to_vertex_handle(m_.next_halfedge_handle(h0)), m_.to_vertex_handle(m_.next_halfedge_handle(h1))};
   m_.flip(e);
   ++report_.flips;
-  for (auto v : {a, b, c, d}) mark_fresh(v);
-  return true;
+  for (auto v : quad) mark_fresh(v);
 }
 
 double Remesher::relocate(VertexHandle v) {
   char kind = m_.property(kind_, v);
-  if (kind == kLockedVertex || m_.is_isolated(v)) return 0;
+  if (kind == kLockedVertex || kind == kCornerVertex || m_.is_isolated(v)) return 0;
   const Vec3 p = m_.point(v);
   Vec3 target(0, 0, 0);
   if (kind == kFreeVertex) {
@@ -566,21 +637,49 @@ double Remesher::relocate(VertexHandle v) {
     Vec3 d = target - p;
     target = p + d - nv * (d | nv);
   } else {
-    char curve = m_.property(vcurve_, v);
-    int n = 0;
-    for (auto h : m_.voh_range(v))
-      if (m_.property(ecurve_, m_.edge_handle(h)) == curve) {
-        target += m_.point(m_.to_vertex_handle(h));
-        ++n;
-      }
-    if (n != 2) return 0;
-    target = project_on_curve(target / 2.0, curve);
+    auto ends = curve_neighbours(v);
+    if (!ends) return 0;
+    target = project_on_curve((m_.point(ends->first) + m_.point(ends->second)) / 2.0, m_.property(vcurve_, v));
   }
-  SurfacePoint sp = ref_->closest(target, m_.property(hint_, v));
-  Vec3 q = (kind == kCurveVertex && m_.property(vcurve_, v) == kBoundaryCurve && !ref_->analytic()) ? target : sp.point;
-  double moved = (q - p).norm();
-  if (moved < 1e-3 * m_.property(size_, v)) return 0;
-  double old_min = 1, new_min = 1, old_sum = 0, new_sum = 0;
+  Vec3 q;
+  SurfacePoint sp;
+  Change change;
+  if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change)) return 0;
+  // Curve vertices move only to repair a poor triangle: a point between the reference curve's
+  // vertices lies on a chord, off the true curve by up to h²κ/8.
+  if (kind == kCurveVertex && change.old_min >= kCurveRepairQuality) return 0;
+  bool better = change.new_min >= change.old_min || (change.new_min >= 0.6 && change.new_sum > change.old_sum);
+  if (!better) return 0;
+  move_vertex(v, q, sp);
+  return (q - p).norm();
+}
+
+std::optional<std::pair<VertexHandle, VertexHandle>> Remesher::curve_neighbours(VertexHandle v) const {
+  char curve = m_.property(vcurve_, v);
+  VertexHandle ends[2];
+  int n = 0;
+  for (auto h : m_.voh_range(v))
+    if (m_.property(ecurve_, m_.edge_handle(h)) == curve) {
+      if (n < 2) ends[n] = m_.to_vertex_handle(h);
+      ++n;
+    }
+  if (n != 2) return std::nullopt;
+  return std::pair{ends[0], ends[1]};
+}
+
+// Where v goes for a target point: its projection onto S (a boundary vertex of a non-analytic
+// surface stays on its polyline). False for a move too small to matter.
+bool Remesher::place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const {
+  sp = ref_->closest(target, m_.property(hint_, v));
+  bool on_polyline = m_.property(kind_, v) == kCurveVertex && m_.property(vcurve_, v) == kBoundaryCurve && !ref_->analytic();
+  q = on_polyline ? target : sp.point;
+  return (q - m_.point(v)).norm() >= 1e-3 * m_.property(size_, v);
+}
+
+// Whether moving v to q folds none of its triangles (normal: S's normal at q); `change` receives
+// the qualities of v's star.
+bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const {
+  change = Change{};
   for (auto f : m_.vf_range(v)) {
     auto pts = face_points(m_, f);
     auto old_tri = triangle(pts[0], pts[1], pts[2]);
@@ -588,23 +687,109 @@ double Remesher::relocate(VertexHandle v) {
     for (int k = 0; k < 3; ++k)
       if (vs[k] == v) pts[k] = q;
     auto t = triangle(pts[0], pts[1], pts[2]);
-    Vec3 n_old = old_tri.quality > 1e-3 ? old_tri.normal : sp.normal;
-    if ((t.normal | n_old) < 0.7) return 0;
-    old_min = std::min(old_min, old_tri.quality);
-    new_min = std::min(new_min, t.quality);
-    old_sum += old_tri.quality;
-    new_sum += t.quality;
+    Vec3 n_old = old_tri.quality > kReliableNormal ? old_tri.normal : normal;
+    if ((t.normal | n_old) < 0.7) return false;
+    change.old_min = std::min(change.old_min, old_tri.quality);
+    change.new_min = std::min(change.new_min, t.quality);
+    change.old_sum += old_tri.quality;
+    change.new_sum += t.quality;
   }
-  // Curve vertices move only to repair a poor triangle: a point between the reference curve's
-  // vertices lies on a chord, off the true curve by up to h²κ/8.
-  if (kind == kCurveVertex && old_min >= kCurveRepairQuality) return 0;
-  bool better = new_min >= old_min || (new_min >= 0.6 && new_sum > old_sum);
-  if (!better) return 0;
+  return true;
+}
+
+void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
   m_.set_point(v, q);
   m_.property(hint_, v) = sp.face;
   m_.property(vnormal_, v) = sp.normal;
   ++report_.relocations;
-  return moved;
+}
+
+// Sliver repair, after the passes: each triangle still below kRepairBelow, worst first, gets the
+// local operation that most raises the worst quality around it (a collapse of one of its edges,
+// a flip, or a move of one of its vertices to one of a few candidate points). Unlike the passes,
+// which keep every new triangle above kAcceptQuality, this accepts any strict improvement: it is
+// what untangles clusters of slivers where every single step of the passes would be refused.
+void Remesher::repair_slivers() {
+  for (int round = 0; round < kRepairRounds; ++round) {
+    std::vector<std::pair<double, FaceHandle>> bad;
+    for (auto f : m_.faces())
+      if (double q = face_quality(f); q < kRepairBelow) bad.emplace_back(q, f);
+    std::sort(bad.begin(), bad.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    std::size_t repaired = 0;
+    for (auto [q, f] : bad)
+      if (!m_.status(f).deleted() && face_quality(f) < kRepairBelow && repair(f)) ++repaired;
+    if (repaired == 0) break;
+  }
+}
+
+bool Remesher::repair(FaceHandle f) {
+  enum class Op { None, Collapse, Flip, Move } best_op = Op::None;
+  double best = 0;
+  HalfedgeHandle best_h;
+  VertexHandle best_v;
+  Vec3 best_q;
+  SurfacePoint best_sp;
+  auto consider = [&](const Change& c) { return c.new_min > c.old_min + 1e-3 && c.new_min > best; };
+  for (auto h : m_.fh_range(f)) {
+    for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
+      Change c;
+      if (collapse_check(hh, c) && consider(c)) {
+        best = c.new_min;
+        best_op = Op::Collapse;
+        best_h = hh;
+      }
+    }
+    Change c;
+    if (flip_check(m_.edge_handle(h), c, kRepairFlatness) && consider(c)) {
+      best = c.new_min;
+      best_op = Op::Flip;
+      best_h = h;
+    }
+  }
+  for (auto v : m_.fv_range(f)) {
+    char kind = m_.property(kind_, v);
+    std::vector<Vec3> targets;
+    if (kind == kFreeVertex) {
+      // The centroid of the ring, and the apex of the equilateral triangle on the opposite edge.
+      Vec3 centroid(0, 0, 0);
+      int n = 0;
+      for (auto w : m_.vv_range(v)) {
+        centroid += m_.point(w);
+        ++n;
+      }
+      targets.push_back(centroid / double(n));
+      auto h = m_.next_halfedge_handle(m_.halfedge_handle(f));
+      while (m_.from_vertex_handle(h) == v || m_.to_vertex_handle(h) == v) h = m_.next_halfedge_handle(h);
+      const Vec3 &a = m_.point(m_.from_vertex_handle(h)), &b = m_.point(m_.to_vertex_handle(h));
+      Vec3 side = m_.property(vnormal_, v) % (b - a);
+      targets.push_back((a + b) * 0.5 + side * (std::sqrt(3.0) / 2));
+    } else if (kind == kCurveVertex) {
+      // Points along the curve between its two neighbours.
+      auto ends = curve_neighbours(v);
+      if (!ends) continue;
+      const Vec3 &a = m_.point(ends->first), &b = m_.point(ends->second);
+      for (double t : {0.2, 0.35, 0.5, 0.65, 0.8}) targets.push_back(project_on_curve(a + (b - a) * t, m_.property(vcurve_, v)));
+    }
+    for (const auto& target : targets) {
+      Vec3 q;
+      SurfacePoint sp;
+      Change c;
+      if (place(v, target, q, sp) && move_check(v, q, sp.normal, c) && consider(c)) {
+        best = c.new_min;
+        best_op = Op::Move;
+        best_v = v;
+        best_q = q;
+        best_sp = sp;
+      }
+    }
+  }
+  switch (best_op) {
+    case Op::Collapse: collapse_halfedge(best_h); return true;
+    case Op::Flip: flip_edge(m_.edge_handle(best_h)); return true;
+    case Op::Move: move_vertex(best_v, best_q, best_sp); return true;
+    case Op::None: return false;
+  }
+  return false;
 }
 
 RemeshReport Remesher::run() {
@@ -695,6 +880,8 @@ RemeshReport Remesher::run() {
   for (auto v : next_) m_.property(in_next_, v) = 0;
 
   stamp("passes");
+  repair_slivers();
+  stamp("repair");
   release();
   if (report_.collapses > 0) m_.garbage_collection();
   stamp("gc");
