@@ -458,3 +458,36 @@ TEST_CASE("jagged fronts: no sliver survives where a noisy level set meets the b
   MESSAGE("worst quality over the 12 jagged fronts: " << worst);
   CHECK(worst >= 0.3);
 }
+
+TEST_CASE("a surface far more curved than the mesh: cuts, splits and moves projected onto it never fold the mesh") {
+  // A steep landscape (3 km heights over 3 km features) meshed at 800 m, whose chords sag by
+  // hundreds of metres below the true surface (a 100 m mesh of the same heights): every point the
+  // remesher puts on S moves far from the chord it came from. Each change must be checked against
+  // the neighbouring triangles, not only against its own old normal (before: folds of 162–176°).
+  const TerrainOptions fine{.extent = 20000, .h = 100, .seed = 7, .max_height = 3000, .feature_size = 3000};
+  TerrainOptions coarse = fine;
+  coarse.h = 800;
+  auto surface = std::make_shared<const ReferenceSurface>(make_terrain(fine));
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    SurfaceMesh mesh = make_terrain(coarse);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> centre(6000, 14000), noise(-150, 150);
+    const double cx = centre(rng), cy = centre(rng);
+    ScalarField phi(mesh.n_vertices());
+    for (auto v : mesh.vertices()) {
+      auto p = mesh.point(v);
+      phi[v.idx()] = std::hypot(p[0] - cx, p[1] - cy) - 2500 + noise(rng);
+    }
+    discretize(mesh, phi, EvolutionOptions{}.discretize);
+    RemeshOptions options;
+    options.hmax = coarse.h;
+    options.feature_angle = 0;
+    options.reference = surface;
+    remesh(mesh, options);
+    ValidateOptions vo;
+    vo.euler_characteristic = 1;
+    vo.boundary_loops = 1;
+    INFO("seed " << seed);
+    CHECK(problems(mesh, vo) == "");
+  }
+}

@@ -47,6 +47,9 @@ constexpr double kReliableNormal = 1e-3;
 // A flip's two new triangles must be within 20° of the mean vertex normal (within 45° for repairs,
 // the bound of collapses and moves).
 constexpr double kFlipFlatness = 0.9396926207859084, kRepairFlatness = 0.7;
+// No operation may leave two adjacent triangles whose normals are further apart than 135°
+// (validate_mesh reports 160° as a fold).
+constexpr double kFoldCos = -0.7071067811865476;
 // Triangles still below this quality after the passes go to the sliver repair, for at most
 // kRepairRounds sweeps.
 constexpr double kRepairBelow = 0.3;
@@ -142,6 +145,8 @@ class Remesher {
   bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
   bool move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const;
   void move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp);
+  bool folds(const std::vector<std::array<VertexHandle, 3>>& triangles, const std::vector<FaceHandle>& replaced,
+             VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
   void repair_slivers();
   bool repair(FaceHandle f);
   std::optional<std::pair<VertexHandle, VertexHandle>> curve_neighbours(VertexHandle v) const;
@@ -256,13 +261,17 @@ void Remesher::classify_features() {
     m_.property(hint_, v) = hint;
   });
   // Cut points lie on chords of S: put the interface on S before it becomes the reference curve
-  // (a no-op when S is the input mesh itself).
+  // (a no-op when S is the input mesh itself). Where the chords sag far from S (a steep terrain at
+  // hmax = 400 m: up to 130 m) that move can fold a thin triangle next to the cut; such a point
+  // stays where it is, within the sag of S.
   if (opt_.reference)
     for (auto e : m_.edges())
       if (m_.property(ecurve_, e) == kInterfaceCurve)
         for (auto v : {m_.from_vertex_handle(m_.halfedge_handle(e, 0)), m_.to_vertex_handle(m_.halfedge_handle(e, 0))})
           if (!m_.required(v) && !m_.corner(v)) {
             auto sp = ref_->closest(m_.point(v), m_.property(hint_, v));
+            Change change;
+            if (!move_check(v, sp.point, sp.normal, change)) continue;
             m_.set_point(v, sp.point);
             m_.property(hint_, v) = sp.face;
           }
@@ -423,6 +432,8 @@ bool Remesher::split(EdgeHandle e) {
   // The two (or one) opposite vertices and their face regions; the new point must not fold them.
   VertexHandle opposite[2];
   int region[2] = {0, 0};
+  std::vector<FaceHandle> replaced;
+  std::vector<std::array<VertexHandle, 3>> after;  // the new vertex is the invalid handle, at p
   for (int s = 0; s < 2; ++s) {
     auto h = s == 0 ? h0 : h1;
     if (m_.is_boundary(h)) continue;
@@ -434,7 +445,11 @@ bool Remesher::split(EdgeHandle e) {
     if (n_old.sqrnorm() == 0) n_old = m_.property(vnormal_, a);
     auto t1 = triangle(m_.point(from), p, o), t2 = triangle(p, m_.point(to), o);
     if ((t1.normal | n_old) < 0.3 || (t2.normal | n_old) < 0.3) return false;
+    replaced.push_back(m_.face_handle(h));
+    after.push_back({from, VertexHandle(), opposite[s]});
+    after.push_back({VertexHandle(), to, opposite[s]});
   }
+  if (folds(after, replaced, VertexHandle(), p)) return false;
   // Edge attributes carried by the two halves.
   bool interface = m_.interface(e), ridge = m_.ridge(e);
   int ref = m_.edge_ref(e);
@@ -477,6 +492,48 @@ bool Remesher::split(EdgeHandle e) {
   return true;
 }
 
+// Whether new triangles (replacing the faces `replaced`, with the vertex `moved` placed at `at`)
+// fold onto a neighbour: a dihedral angle beyond 135° with an adjacent new triangle or an unchanged
+// face. The per-triangle normal tests only bound how far each triangle turns from its own old
+// normal, which on a strongly curved S (a steep terrain at 400 m) lets it turn onto a neighbour.
+bool Remesher::folds(const std::vector<std::array<VertexHandle, 3>>& triangles, const std::vector<FaceHandle>& replaced,
+                     VertexHandle moved, const Vec3& at) const {
+  auto position = [&](VertexHandle v) -> const Vec3& { return v == moved ? at : m_.point(v); };
+  auto normal_of = [&](const std::array<VertexHandle, 3>& t) {
+    return triangle(position(t[0]), position(t[1]), position(t[2])).normal;
+  };
+  std::vector<Vec3> normals;
+  normals.reserve(triangles.size());
+  for (const auto& t : triangles) normals.push_back(normal_of(t));
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    if (normals[i].sqrnorm() == 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      // The neighbour across u→w holds w→u: another new triangle, or else an unchanged face.
+      VertexHandle u = triangles[i][k], w = triangles[i][(k + 1) % 3];
+      Vec3 other(0, 0, 0);
+      bool found = false;
+      for (std::size_t j = 0; j < triangles.size() && !found; ++j)
+        for (int l = 0; l < 3 && j != i; ++l)
+          if (triangles[j][l] == w && triangles[j][(l + 1) % 3] == u) {
+            other = normals[j];
+            found = true;
+            break;
+          }
+      if (!found) {
+        if (!u.is_valid() || !w.is_valid()) continue;  // an edge of a vertex not yet in the mesh
+        auto h = m_.find_halfedge(w, u);
+        if (!h.is_valid() || m_.is_boundary(h)) continue;
+        auto f = m_.face_handle(h);
+        if (std::find(replaced.begin(), replaced.end(), f) != replaced.end()) continue;
+        auto vs = face_vertices(m_, f);
+        other = normal_of({vs[0], vs[1], vs[2]});
+      }
+      if (other.sqrnorm() > 0 && (normals[i] | other) < kFoldCos) return true;
+    }
+  }
+  return false;
+}
+
 // Whether the curve stays within hausd of the curve vertex v0 when it collapses along h onto v1:
 // the new curve edge (u, v1), u the other curve neighbour of v0, must pass within hausd of v0.
 bool Remesher::curve_collapse_within_hausd(HalfedgeHandle h) const {
@@ -514,7 +571,10 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
   if ((kind == kCurveVertex || kind == kCornerVertex) && !curve_collapse_within_hausd(h)) return false;
   const Vec3& p1 = m_.point(v1);
   double old_min = 1, new_min = 1;
+  std::vector<FaceHandle> star;
+  std::vector<std::array<VertexHandle, 3>> after;
   for (auto f : m_.vf_range(v0)) {
+    star.push_back(f);
     auto pts = face_points(m_, f);
     auto old_tri = triangle(pts[0], pts[1], pts[2]);
     old_min = std::min(old_min, old_tri.quality);
@@ -523,12 +583,17 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
     if (has_v1) continue;
     auto vs = face_vertices(m_, f);
     for (int k = 0; k < 3; ++k)
-      if (vs[k] == v0) pts[k] = p1;
+      if (vs[k] == v0) {
+        pts[k] = p1;
+        vs[k] = v1;
+      }
     auto t = triangle(pts[0], pts[1], pts[2]);
     Vec3 n_old = old_tri.quality > kReliableNormal ? old_tri.normal : m_.property(vnormal_, v0);
     if ((t.normal | n_old) < 0.7) return false;
     new_min = std::min(new_min, t.quality);
+    after.push_back({vs[0], vs[1], vs[2]});
   }
+  if (folds(after, star)) return false;
   for (auto w : m_.vv_range(v0)) {
     if (w == v1) continue;
     // No edge too long, unless it was already (the split pass deals with it).
@@ -607,6 +672,7 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, double min_cos) const {
   if (len <= 0) return false;
   n /= len;
   if ((t0.normal | n) < min_cos || (t1.normal | n) < min_cos) return false;
+  if (folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h0), m_.face_handle(h1)})) return false;
   change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
   change.new_min = std::min(t0.quality, t1.quality);
   return true;
@@ -680,7 +746,12 @@ bool Remesher::place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& 
 // the qualities of v's star.
 bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const {
   change = Change{};
+  std::vector<FaceHandle> star;
+  std::vector<std::array<VertexHandle, 3>> after;
   for (auto f : m_.vf_range(v)) {
+    star.push_back(f);
+    auto fv = face_vertices(m_, f);
+    after.push_back({fv[0], fv[1], fv[2]});
     auto pts = face_points(m_, f);
     auto old_tri = triangle(pts[0], pts[1], pts[2]);
     auto vs = face_vertices(m_, f);
@@ -694,7 +765,7 @@ bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Cha
     change.old_sum += old_tri.quality;
     change.new_sum += t.quality;
   }
-  return true;
+  return !folds(after, star, v, q);
 }
 
 void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
