@@ -41,9 +41,8 @@ constexpr double kAcceptQuality = 0.4;
 constexpr double kCurveRepairQuality = 0.6;
 // Flips are tried only when the worse triangle of the pair is below this quality.
 constexpr double kFlipBelow = 0.75;
-// Below this quality a triangle's normal says little about S: moves are checked against the
-// vertex normal instead.
-constexpr double kReliableNormal = 1e-3;
+// Below this quality a triangle's normal says little about S (keeps_facing).
+constexpr double kReliableNormal = 0.1;
 // A flip's two new triangles must be within 20° of the mean vertex normal (within 45° for repairs,
 // the bound of collapses and moves).
 constexpr double kFlipFlatness = 0.9396926207859084, kRepairFlatness = 0.7;
@@ -81,6 +80,19 @@ Tri triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
 struct Change {
   double old_min = 1, new_min = 1, old_sum = 0, new_sum = 0;
 };
+
+// A changed triangle may turn by up to 45° from its old normal; a poor old triangle's normal says
+// little about S, so for one below kReliableNormal, 45° from S's normal there is enough too (folds
+// onto neighbours are checked separately).
+bool keeps_facing(const Tri& old_tri, const Tri& new_tri, const Vec3& surface_normal) {
+  if ((new_tri.normal | old_tri.normal) >= 0.7) return true;
+  return old_tri.quality < kReliableNormal && (new_tri.normal | surface_normal) >= 0.7;
+}
+
+// Which changes are worth making, judged on their qualities before the costlier fold test: the
+// passes' (a collapse keeps every new triangle above min(kAcceptQuality, the worst it replaces); a
+// flip improves a pair below kFlipBelow) or the sliver repair's (any strict improvement).
+enum class Rule { Pass, Repair };
 
 class Remesher {
  public:
@@ -135,11 +147,11 @@ class Remesher {
 
   bool split(EdgeHandle e);
   bool collapse(EdgeHandle e);
-  bool collapse_check(HalfedgeHandle h, Change& change) const;
+  bool collapse_check(HalfedgeHandle h, Change& change, Rule rule) const;
   bool curve_collapse_within_hausd(HalfedgeHandle h) const;
   void collapse_halfedge(HalfedgeHandle h);
   bool flip(EdgeHandle e);
-  bool flip_check(EdgeHandle e, Change& change, double min_cos = kFlipFlatness) const;
+  bool flip_check(EdgeHandle e, Change& change, Rule rule) const;
   void flip_edge(EdgeHandle e);
   double relocate(VertexHandle v);
   bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
@@ -551,8 +563,9 @@ bool Remesher::curve_collapse_within_hausd(HalfedgeHandle h) const {
 }
 
 // Whether collapsing h (its from-vertex v0 onto its to-vertex v1) keeps features, topology and
-// geometry (no fold, no edge made too long); `change` receives the qualities of v0's star.
-bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
+// geometry (no fold, no edge made too long) and is worth it by `rule`; `change` receives the
+// qualities of v0's star.
+bool Remesher::collapse_check(HalfedgeHandle h, Change& change, Rule rule) const {
   auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
   auto e = m_.edge_handle(h);
   char kind = m_.property(kind_, v0);
@@ -588,18 +601,18 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
         vs[k] = v1;
       }
     auto t = triangle(pts[0], pts[1], pts[2]);
-    Vec3 n_old = old_tri.quality > kReliableNormal ? old_tri.normal : m_.property(vnormal_, v0);
-    if ((t.normal | n_old) < 0.7) return false;
+    if (!keeps_facing(old_tri, t, m_.property(vnormal_, v0))) return false;
     new_min = std::min(new_min, t.quality);
     after.push_back({vs[0], vs[1], vs[2]});
   }
-  if (folds(after, star)) return false;
+  if (rule == Rule::Pass ? new_min < std::min(kAcceptQuality, old_min) : new_min <= old_min + 1e-3) return false;
   for (auto w : m_.vv_range(v0)) {
     if (w == v1) continue;
     // No edge too long, unless it was already (the split pass deals with it).
     double l = (m_.point(w) - p1).norm();
     if (l > kSplitRatio * target(v1, w) && l > (m_.point(w) - m_.point(v0)).norm()) return false;
   }
+  if (folds(after, star)) return false;
   change.old_min = old_min;
   change.new_min = new_min;
   return true;
@@ -608,8 +621,7 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change) const {
 bool Remesher::collapse(EdgeHandle e) {
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
   Change c0, c1;
-  auto acceptable = [](const Change& c) { return c.new_min >= std::min(kAcceptQuality, c.old_min); };
-  bool ok0 = collapse_check(h0, c0) && acceptable(c0), ok1 = collapse_check(h1, c1) && acceptable(c1);
+  bool ok0 = collapse_check(h0, c0, Rule::Pass), ok1 = collapse_check(h1, c1, Rule::Pass);
   if (!ok0 && !ok1) return false;
   collapse_halfedge((ok0 && (!ok1 || c0.new_min >= c1.new_min)) ? h0 : h1);
   return true;
@@ -650,14 +662,14 @@ void Remesher::collapse_halfedge(HalfedgeHandle h) {
 
 bool Remesher::flip(EdgeHandle e) {
   Change change;
-  // Only pairs with a poor triangle are worth changing: a good mesh stays as it is.
-  if (!flip_check(e, change) || change.old_min >= kFlipBelow || change.new_min <= change.old_min + 1e-3) return false;
+  if (!flip_check(e, change, Rule::Pass)) return false;
   flip_edge(e);
   return true;
 }
 
-// Whether flipping e keeps the pair flat on S; `change` receives the qualities of the two pairs.
-bool Remesher::flip_check(EdgeHandle e, Change& change, double min_cos) const {
+// Whether flipping e keeps the pair flat on S and is worth it by `rule`; `change` receives the
+// qualities of the two pairs.
+bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   if (m_.property(ecurve_, e) != kNoCurve || m_.is_boundary(e)) return false;
   if (!const_cast<SurfaceMesh&>(m_).is_flip_ok(e)) return false;
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
@@ -666,16 +678,18 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, double min_cos) const {
   auto d = m_.to_vertex_handle(m_.next_halfedge_handle(h1));
   const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
   auto t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
+  change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+  change.new_min = std::min(t0.quality, t1.quality);
+  // Only pairs with a poor triangle are worth changing in the passes: a good mesh stays as it is.
+  if (change.new_min <= change.old_min + 1e-3 || (rule == Rule::Pass && change.old_min >= kFlipBelow)) return false;
   // The new pair must lie flat on S (no fold, no shortcut across curvature).
   Vec3 n = m_.property(vnormal_, a) + m_.property(vnormal_, b) + m_.property(vnormal_, c) + m_.property(vnormal_, d);
   double len = n.norm();
   if (len <= 0) return false;
   n /= len;
+  const double min_cos = rule == Rule::Pass ? kFlipFlatness : kRepairFlatness;
   if ((t0.normal | n) < min_cos || (t1.normal | n) < min_cos) return false;
-  if (folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h0), m_.face_handle(h1)})) return false;
-  change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
-  change.new_min = std::min(t0.quality, t1.quality);
-  return true;
+  return !folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h0), m_.face_handle(h1)});
 }
 
 void Remesher::flip_edge(EdgeHandle e) {
@@ -746,26 +760,48 @@ bool Remesher::place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& 
 // the qualities of v's star.
 bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const {
   change = Change{};
-  std::vector<FaceHandle> star;
-  std::vector<std::array<VertexHandle, 3>> after;
-  for (auto f : m_.vf_range(v)) {
-    star.push_back(f);
-    auto fv = face_vertices(m_, f);
-    after.push_back({fv[0], fv[1], fv[2]});
-    auto pts = face_points(m_, f);
-    auto old_tri = triangle(pts[0], pts[1], pts[2]);
-    auto vs = face_vertices(m_, f);
-    for (int k = 0; k < 3; ++k)
-      if (vs[k] == v) pts[k] = q;
-    auto t = triangle(pts[0], pts[1], pts[2]);
-    Vec3 n_old = old_tri.quality > kReliableNormal ? old_tri.normal : normal;
-    if ((t.normal | n_old) < 0.7) return false;
+  // The star of v, one spoke per outgoing halfedge h: its face (if any) is (v, w1, w2), w1 = to(h),
+  // w2 = to(next(h)); the face across (w2, w1) is unchanged by the move.
+  constexpr int kMaxStar = 64;
+  Vec3 moved_normal[kMaxStar];
+  HalfedgeHandle spoke[kMaxStar];
+  int n = 0;
+  const Vec3& p = m_.point(v);
+  for (auto h : m_.voh_range(v)) {
+    if (n == kMaxStar) return false;  // no such valence in a mesh worth relocating in
+    spoke[n] = h;
+    Vec3& moved = moved_normal[n++];
+    moved = Vec3(0, 0, 0);
+    if (m_.is_boundary(h)) continue;
+    auto h2 = m_.next_halfedge_handle(h);
+    const Vec3 &w1 = m_.point(m_.to_vertex_handle(h)), &w2 = m_.point(m_.to_vertex_handle(h2));
+    auto old_tri = triangle(p, w1, w2), t = triangle(q, w1, w2);
+    if (!keeps_facing(old_tri, t, normal)) return false;
     change.old_min = std::min(change.old_min, old_tri.quality);
     change.new_min = std::min(change.new_min, t.quality);
     change.old_sum += old_tri.quality;
     change.new_sum += t.quality;
+    moved = t.normal;
+    // No fold (folds(), specialised to a star): against the unchanged face across (w2, w1)...
+    auto outer = m_.opposite_halfedge_handle(h2);
+    if (moved.sqrnorm() > 0 && !m_.is_boundary(outer)) {
+      const Vec3& x = m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(outer)));
+      Vec3 other = (w1 - w2) % (x - w2);
+      double len = other.norm();
+      if (len > 0 && (moved | other) < kFoldCos * len) return false;
+    }
   }
-  return !folds(after, star, v, q);
+  // ... and against the moved face across (v, w1), the one whose spoke follows the opposite halfedge.
+  for (int i = 0; i < n; ++i) {
+    if (moved_normal[i].sqrnorm() == 0) continue;
+    auto across = m_.opposite_halfedge_handle(spoke[i]);
+    if (m_.is_boundary(across)) continue;
+    auto next_spoke = m_.next_halfedge_handle(across);
+    for (int j = 0; j < n; ++j)
+      if (spoke[j] == next_spoke && moved_normal[j].sqrnorm() > 0 && (moved_normal[i] | moved_normal[j]) < kFoldCos)
+        return false;
+  }
+  return true;
 }
 
 void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
@@ -804,14 +840,14 @@ bool Remesher::repair(FaceHandle f) {
   for (auto h : m_.fh_range(f)) {
     for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
       Change c;
-      if (collapse_check(hh, c) && consider(c)) {
+      if (collapse_check(hh, c, Rule::Repair) && consider(c)) {
         best = c.new_min;
         best_op = Op::Collapse;
         best_h = hh;
       }
     }
     Change c;
-    if (flip_check(m_.edge_handle(h), c, kRepairFlatness) && consider(c)) {
+    if (flip_check(m_.edge_handle(h), c, Rule::Repair) && consider(c)) {
       best = c.new_min;
       best_op = Op::Flip;
       best_h = h;
