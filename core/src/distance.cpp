@@ -52,11 +52,20 @@ struct FrontValue {
 };
 
 /// Curvature of the front after it travels `step` from where it was κ, on a surface of Gaussian
-/// curvature K: the Riccati equation of parallel curves, dκ/ds = −κ² − K. The flat part is exact
-/// (κ / (1 + κ·step), a circle grows by the step); the Gaussian term is taken at first order.
+/// curvature K: the Riccati equation of parallel curves, dκ/ds = −κ² − K, by Strang splitting —
+/// half the K term, the exact flat growth κ/(1 + κs), the other half — second order in the step.
+/// (Taking the K term at first order left the distance from a great circle of a 0.1-edge sphere
+/// 7 % further off; the exact tan/tanh solution is no better than this and costs more.)
 double carried_curvature(double kappa, double step, double gauss) {
+  const double half = kappa - 0.5 * gauss * step;
+  const double grown = 1 + half * step;
+  return (grown > 1e-12 ? half / grown : half) - 0.5 * gauss * step;
+}
+
+/// The part of carried_curvature due to K alone (what the exact flat growth κ/(1 + κs) misses).
+double gaussian_part(double kappa, double step, double gauss) {
   const double grown = 1 + kappa * step;
-  return (grown > 1e-12 ? kappa / grown : kappa) - gauss * step;
+  return carried_curvature(kappa, step, gauss) - (grown > 1e-12 ? kappa / grown : kappa);
 }
 
 /// Update of x from a and b whose front is a circle rather than a line: in the plane of the
@@ -113,7 +122,8 @@ FrontValue front_update(const CornerGeometry& g, double da, double db, double ka
   const double value = diverging ? 0.5 * (da + grow_a + db + grow_b) : 0.5 * (da - grow_a + db - grow_b);
   if (!(value >= std::max(da, db)) || !(to_x > 0)) return planar();
   out.d = value;
-  out.kappa = (diverging ? 1 / to_x : -1 / to_x) - gauss * (value - mean_d);
+  // The circle through x gives the flat growth exactly; K adds its share of the Riccati solution.
+  out.kappa = (diverging ? 1 / to_x : -1 / to_x) + gaussian_part(mean_k, value - mean_d, gauss);
   return out;
 }
 
