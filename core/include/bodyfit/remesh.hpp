@@ -1,7 +1,8 @@
 #pragma once
 // Interface-preserving adaptive remeshing of a surface mesh (second half of step 4 of Algorithm 1,
-// paper §3.4): split / collapse / flip / relocate until sizes and qualities settle, keeping S, the
-// interface curve, ridges, corners, boundaries and required entities.
+// paper §3.4): split / collapse / flip / relocate until sizes and qualities settle, then repair the
+// slivers left, never folding the mesh, keeping S, the interface curve, ridges, corners, boundaries
+// and required entities.
 #include <bodyfit/mesh.hpp>
 
 #include <memory>
