@@ -162,9 +162,14 @@ class Remesher {
   void repair_slivers();
   bool repair(FaceHandle f);
   std::optional<std::pair<VertexHandle, VertexHandle>> curve_neighbours(VertexHandle v) const;
-  double face_quality(FaceHandle f) const {
-    auto p = face_points(m_, f);
-    return triangle(p[0], p[1], p[2]).quality;
+  Vec3 ring_centroid(VertexHandle v) const {
+    Vec3 sum(0, 0, 0);
+    int n = 0;
+    for (auto w : m_.vv_range(v)) {
+      sum += m_.point(w);
+      ++n;
+    }
+    return n > 0 ? sum / double(n) : m_.point(v);
   }
 
   Vec3 project_on_curve(const Vec3& p, char curve) const { return curves_.closest(p, curve); }
@@ -707,14 +712,8 @@ double Remesher::relocate(VertexHandle v) {
   const Vec3 p = m_.point(v);
   Vec3 target(0, 0, 0);
   if (kind == kFreeVertex) {
-    int n = 0;
-    for (auto w : m_.vv_range(v)) {
-      target += m_.point(w);
-      ++n;
-    }
-    target /= double(n);
     const Vec3& nv = m_.property(vnormal_, v);
-    Vec3 d = target - p;
+    Vec3 d = ring_centroid(v) - p;
     target = p + d - nv * (d | nv);
   } else {
     auto ends = curve_neighbours(v);
@@ -820,11 +819,11 @@ void Remesher::repair_slivers() {
   for (int round = 0; round < kRepairRounds; ++round) {
     std::vector<std::pair<double, FaceHandle>> bad;
     for (auto f : m_.faces())
-      if (double q = face_quality(f); q < kRepairBelow) bad.emplace_back(q, f);
+      if (double q = face_quality(m_, f); q < kRepairBelow) bad.emplace_back(q, f);
     std::sort(bad.begin(), bad.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     std::size_t repaired = 0;
     for (auto [q, f] : bad)
-      if (!m_.status(f).deleted() && face_quality(f) < kRepairBelow && repair(f)) ++repaired;
+      if (!m_.status(f).deleted() && face_quality(m_, f) < kRepairBelow && repair(f)) ++repaired;
     if (repaired == 0) break;
   }
 }
@@ -858,13 +857,7 @@ bool Remesher::repair(FaceHandle f) {
     std::vector<Vec3> targets;
     if (kind == kFreeVertex) {
       // The centroid of the ring, and the apex of the equilateral triangle on the opposite edge.
-      Vec3 centroid(0, 0, 0);
-      int n = 0;
-      for (auto w : m_.vv_range(v)) {
-        centroid += m_.point(w);
-        ++n;
-      }
-      targets.push_back(centroid / double(n));
+      targets.push_back(ring_centroid(v));
       auto h = m_.next_halfedge_handle(m_.halfedge_handle(f));
       while (m_.from_vertex_handle(h) == v || m_.to_vertex_handle(h) == v) h = m_.next_halfedge_handle(h);
       const Vec3 &a = m_.point(m_.from_vertex_handle(h)), &b = m_.point(m_.to_vertex_handle(h));
