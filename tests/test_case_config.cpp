@@ -135,7 +135,7 @@ TEST_CASE("wrong types and values are errors naming the key") {
   e = error_of(kValidCase, {"output.vtu_every=1.5"});
   CHECK_MESSAGE(contains(e, "[output] vtu_every: expected an integer"), e);
   e = error_of(kValidCase, {"remesh.hmax=-1"});
-  CHECK_MESSAGE(contains(e, "[remesh] hmax: must be > 0"), e);
+  CHECK_MESSAGE(contains(e, "[remesh] hmax: -1 is out of range (0, inf)"), e);
   e = error_of(kValidCase, {"region.axis=[1, 2]"});
   CHECK_MESSAGE(contains(e, "[region] axis: expected 3 numbers, got 2"), e);
   e = error_of(kValidCase, {"surface.extent=5"});
@@ -143,9 +143,32 @@ TEST_CASE("wrong types and values are errors naming the key") {
   e = error_of(kValidCase, {"time.dt=0.1"});
   CHECK_MESSAGE(contains(e, "exactly one of 'dt' and 'cfl'"), e);
   e = error_of(kValidCase, {"time.max_cfl=0"});
-  CHECK_MESSAGE(contains(e, "[time] max_cfl: must be > 0"), e);
+  CHECK_MESSAGE(contains(e, "[time] max_cfl: 0 is out of range (0, inf)"), e);
   e = error_of(kValidCase, {"time.max_cf=2"});
   CHECK_MESSAGE(contains(e, "unknown key 'max_cf' in [time]; did you mean 'max_cfl'?"), e);
+  e = error_of(kValidCase, {"region.angle=180"});
+  CHECK_MESSAGE(contains(e, "[region] angle: must be in (0, 180) degrees (got 180)"), e);
+  e = error_of(kValidCase, {"advection.rk_order=3"});
+  CHECK_MESSAGE(contains(e, "[advection] rk_order: must be 2 or 4 (got 3)"), e);
+  e = error_of(kValidCase, {"remesh.hmin=0.5"});
+  CHECK_MESSAGE(contains(e, "[remesh] hmin: 0.5 must not exceed hmax = 0.2"), e);
+  // A value written in the text is located by its line.
+  std::string text = kValidCase;
+  text.replace(text.find("hmax = 0.2"), 10, "hmax = \"big\"");
+  e = error_of(text);
+  CHECK_MESSAGE(contains(e, "line 20: [remesh] hmax: expected a number, got a string"), e);
+}
+
+TEST_CASE("[time] max_rejections: an integer >= 0, default 5") {
+  CHECK(parse(kValidCase).time.max_rejections == 5);
+  CHECK(parse(kValidCase, {"time.max_rejections=2"}).time.max_rejections == 2);
+  CHECK(parse(kValidCase, {"time.max_rejections=0"}).time.max_rejections == 0);
+  std::string e = error_of(kValidCase, {"time.max_rejections=-1"});
+  CHECK_MESSAGE(contains(e, "[time] max_rejections: -1 is out of range [0, inf)"), e);
+  e = error_of(kValidCase, {"time.max_rejections=2.5"});
+  CHECK_MESSAGE(contains(e, "[time] max_rejections: expected an integer, got a float"), e);
+  e = error_of(kValidCase, {"time.max_rejection=3"});
+  CHECK_MESSAGE(contains(e, "unknown key 'max_rejection' in [time]; did you mean 'max_rejections'?"), e);
 }
 
 TEST_CASE("--set overrides any key with a dotted path, typed as TOML") {
@@ -181,6 +204,26 @@ TEST_CASE("every example case of meshes/cases is valid") {
     FAIL("expected an error");
   } catch (const InputError& e) {
     CHECK(contains(e.what(), "bad.toml:"));
+  }
+  // A bad value names the file and its line, once; a bad --set value names the file.
+  {
+    std::string text = kValidCase;
+    text.replace(text.find("final_time = 0.78"), 17, "final_time = -1.0");
+    std::ofstream out(dir / "negative.toml");
+    out << text;
+  }
+  const std::string file = (dir / "negative.toml").string();
+  try {
+    read_case(dir / "negative.toml");
+    FAIL("expected an error");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == file + ":17: [time] final_time: -1 is out of range (0, inf)");
+  }
+  try {
+    read_case(dir / "negative.toml", {"time.final_time=1.0", "time.iterations=-2"});
+    FAIL("expected an error");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()) == file + ": [time] iterations: -2 is out of range [0, inf)");
   }
 }
 

@@ -1,5 +1,6 @@
-// Generators: geodesic spheres (counts, quality, radius, topology), procedural terrains
-// (boundary, topology, heights, reproducibility, edge lengths), DEM rasters (.asc, GeoTIFF).
+// Generators: geodesic spheres (counts, quality, radius, topology), flat squares (counts, flatness,
+// boundary, quality), procedural terrains (boundary, topology, heights, reproducibility, edge
+// lengths), DEM rasters (.asc, GeoTIFF).
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
@@ -80,6 +81,44 @@ TEST_CASE("sphere: the area converges to 4 pi r^2 from below") {
 TEST_CASE("sphere: bad options are input errors") {
   CHECK_THROWS_AS(make_sphere({.faces = 19}), InputError);
   CHECK_THROWS_AS(make_sphere({.faces = 100, .radius = 0}), InputError);
+}
+
+// ---- planes --------------------------------------------------------------------------------------
+
+TEST_CASE("plane: a flat square of near-equilateral rows, one boundary loop on the square's sides") {
+  auto mesh = make_plane({.size = 2.0, .h = 0.1});
+  // 23 rows of triangles of height ≈ h·√3/2, each 2·20 triangles; 24 rows of 21 vertices.
+  CHECK(mesh.n_faces() == 23u * 40u);
+  CHECK(mesh.n_vertices() == 24u * 21u);
+  CHECK(euler_characteristic(mesh) == 1);
+  CHECK(connected_components(mesh) == 1);
+  for (auto v : mesh.vertices()) CHECK(mesh.point(v)[2] == 0);
+  for (auto f : mesh.faces()) {
+    CHECK(face_normal(mesh, f)[2] == doctest::Approx(1.0));  // flat, oriented up
+    CHECK(mesh.region(f) == kOutside);
+  }
+  CHECK(total_area(mesh) == doctest::Approx(4.0).epsilon(1e-12));
+  auto loops = boundary_loops(mesh);
+  REQUIRE(loops.size() == 1);
+  double length = 0;
+  for (std::size_t i = 0; i < loops[0].size(); ++i) {
+    const Vec3 a = mesh.point(loops[0][i]), b = mesh.point(loops[0][(i + 1) % loops[0].size()]);
+    CHECK((std::abs(a[0]) == 1.0 || std::abs(a[1]) == 1.0));
+    CHECK((a[0] == b[0] || a[1] == b[1]));  // along one side
+    length += (b - a).norm();
+  }
+  CHECK(length == doctest::Approx(8.0).epsilon(1e-12));
+  // The half cells at the row ends are the worst triangles.
+  CHECK(quality_stats(mesh).min > 0.5);
+  CHECK(quality_stats(mesh).mean > 0.9);
+  CHECK(edge_length_stats(mesh).mean == doctest::Approx(0.1).epsilon(0.1));
+}
+
+TEST_CASE("plane: bad options are input errors") {
+  CHECK_THROWS_AS(make_plane({.size = 0}), InputError);
+  CHECK_THROWS_AS(make_plane({.size = 2, .h = -0.1}), InputError);
+  CHECK_THROWS_AS(make_plane({.size = 2, .h = std::nan("")}), InputError);
+  CHECK_THROWS_AS(make_plane({.size = 1e6, .h = 1e-3}), InputError);  // 10^18 vertices
 }
 
 // ---- terrains ------------------------------------------------------------------------------------

@@ -38,16 +38,27 @@ std::optional<double> as_number(const toml::node& node) {
   return std::nullopt;
 }
 
-/// "file:line: " when toml++ knows where the node comes from.
-std::string location(const toml::node& node) {
-  const auto& source = node.source();
-  std::string prefix;
-  if (source.path) prefix = *source.path + ":";
-  if (source.begin.line > 0) prefix += fmt::format("{}:", source.begin.line);
-  return prefix.empty() ? prefix : prefix + " ";
+/// "[a, b]" for integers, the type's limits shown as infinite ("[0, inf)").
+std::string describe_integers(std::int64_t min, std::int64_t max) {
+  using limits = std::numeric_limits<std::int64_t>;
+  return fmt::format("{}, {}", min == limits::min() ? "(-inf" : fmt::format("[{}", min),
+                     max == limits::max() ? "inf)" : fmt::format("{}]", max));
+}
+
+/// What an absent table reads as.
+const toml::table& empty_table() {
+  static const toml::table empty;
+  return empty;
 }
 
 }  // namespace
+
+std::string location_of(const toml::node& node) {
+  const auto& source = node.source();
+  if (source.begin.line == 0) return source.path ? *source.path + ": " : "";
+  if (source.path) return fmt::format("{}:{}: ", *source.path, source.begin.line);
+  return fmt::format("line {}: ", source.begin.line);
+}
 
 bool Range::contains(double value) const {
   if (std::isnan(value)) return false;
@@ -63,6 +74,9 @@ std::string Range::describe() const {
 
 Parameters::Parameters(const toml::table& table, std::string section) : table_(table), section_(std::move(section)) {}
 
+Parameters::Parameters(const toml::table* table, std::string section)
+    : Parameters(table ? *table : empty_table(), std::move(section)) {}
+
 bool Parameters::has(std::string_view key) const { return table_.contains(key); }
 
 const toml::node* Parameters::find(std::string_view key) {
@@ -72,7 +86,11 @@ const toml::node* Parameters::find(std::string_view key) {
 
 void Parameters::fail(std::string_view key, const std::string& what) const {
   const toml::node* node = table_.get(key);
-  throw InputError(fmt::format("{}[{}] {}: {}", node ? location(*node) : location(table_), section_, key, what));
+  throw InputError(fmt::format("{}[{}] {}: {}", location_of(node ? *node : table_), section_, key, what));
+}
+
+void Parameters::fail(const std::string& what) const {
+  throw InputError(fmt::format("{}[{}] {}", location_of(table_), section_, what));
 }
 
 double Parameters::number(std::string_view key, double fallback, Range range) {
@@ -95,7 +113,7 @@ std::int64_t Parameters::integer(std::string_view key, std::int64_t fallback, st
   auto value = node->as_integer();
   if (!value) fail(key, fmt::format("expected an integer, got {}", type_name(*node)));
   std::int64_t v = value->get();
-  if (v < min || v > max) fail(key, fmt::format("{} is out of range [{}, {}]", v, min, max));
+  if (v < min || v > max) fail(key, fmt::format("{} is out of range {}", v, describe_integers(min, max)));
   return v;
 }
 
@@ -154,6 +172,30 @@ std::vector<double> Parameters::numbers(std::string_view key, std::vector<double
   return values;
 }
 
+std::vector<std::vector<double>> Parameters::number_arrays(std::string_view key, std::size_t size, Range range) {
+  const toml::node* node = find(key);
+  if (!node) return {};
+  auto array = node->as_array();
+  if (!array) fail(key, fmt::format("expected an array of arrays of {} numbers, got {}", size, type_name(*node)));
+  std::vector<std::vector<double>> rows;
+  for (const auto& element : *array) {
+    const std::size_t item = rows.size() + 1;  // counted from 1, as a reader counts
+    auto row = element.as_array();
+    if (!row) fail(key, fmt::format("item {}: expected an array of {} numbers, got {}", item, size, type_name(element)));
+    if (row->size() != size) fail(key, fmt::format("item {}: expected {} numbers, got {}", item, size, row->size()));
+    std::vector<double> values;
+    for (const auto& entry : *row) {
+      auto value = as_number(entry);
+      if (!value) fail(key, fmt::format("item {}: expected {} numbers, found {} in it", item, size, type_name(entry)));
+      if (!range.contains(*value))
+        fail(key, fmt::format("item {}: {} is out of range {}", item, *value, range.describe()));
+      values.push_back(*value);
+    }
+    rows.push_back(std::move(values));
+  }
+  return rows;
+}
+
 const toml::table* Parameters::table(std::string_view key) {
   const toml::node* node = find(key);
   if (!node) return nullptr;
@@ -173,13 +215,18 @@ void Parameters::accept(const std::vector<ParameterInfo>& infos) {
 void Parameters::reject_unknown() const {
   for (const auto& [key, node] : table_) {
     if (std::find(known_.begin(), known_.end(), key.str()) != known_.end()) continue;
-    std::string message = fmt::format("{}unknown key '{}' in [{}]", location(node), key.str(), section_);
+    std::string message = fmt::format("{}unknown key '{}' in [{}]", location_of(node), key.str(), section_);
     if (auto near = closest_match(key.str(), known_); !near.empty())
       message += fmt::format("; did you mean '{}'?", near);
     else if (!known_.empty())
       message += fmt::format(" (known keys: {})", fmt::join(known_, ", "));
     throw InputError(message);
   }
+}
+
+void Parameters::forbid(const std::vector<std::string>& keys, std::string_view reason) const {
+  for (const auto& key : keys)
+    if (has(key)) fail(key, fmt::format("does not apply {}", reason));
 }
 
 std::size_t edit_distance(std::string_view a, std::string_view b) {

@@ -6,12 +6,17 @@
 //   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
 //                degrees, center; or axes = [[..], ..] and angles = [..] for a union of caps) | "disks" (centers = [[x, y], ...], radii = [...])
 //   [model]      name = "conormal", every other key is the model's own parameter
-//   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations
+//   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, max_rejections
 //   [distance] [advection] [discretize] [remesh]   options of each stage
 //   [output]     vtu_every, png_every, field, view, size = [w, h]
 //
-// Every table and key is checked: an unknown one is an InputError with a suggestion ("unknown key
-// 'tiem' in [time]; did you mean 'time'?"), as is a wrong type or a missing required key.
+// Every table and key is checked (with bodyfit::Parameters): an unknown one is an InputError with a
+// suggestion ("case.toml:9: unknown key 'final_tiem' in [time]; did you mean 'final_time'?"), as is
+// a wrong type, a value out of range or a missing required key.
+//
+// Two halves: reading a case (case_config.cpp: apply_override, parse_case, read_case) and setting
+// up its run (case_setup.cpp: make_case_surface ... setup_case). They share this header because a
+// run needs both and the set-up functions take the CaseConfig.
 #include <bodyfit/advection.hpp>
 #include <bodyfit/distance.hpp>
 #include <bodyfit/evolution.hpp>
@@ -38,8 +43,7 @@ struct SurfaceSpec {
   SphereOptions sphere;             ///< Kind::Sphere
   TerrainOptions terrain;           ///< Kind::Terrain (procedural, or from `dem`)
   std::filesystem::path dem;        ///< Kind::Terrain: a DEM raster instead of the procedural landscape
-  double plane_size = 2;            ///< Kind::Plane: side of the square [-size/2, size/2]², z = 0
-  double plane_h = 0.05;            ///< Kind::Plane: edge length
+  PlaneOptions plane;               ///< Kind::Plane
 };
 
 struct RegionSpec {
@@ -61,6 +65,9 @@ struct TimeSpec {
   double max_cfl = 0;  ///< sub-steps keep max|V|·Δt_sub ≤ max_cfl·h (0: off; EvolutionOptions::max_cfl)
   double final_time = std::numeric_limits<double>::infinity();
   long iterations = -1;  ///< −1: no limit (final_time decides)
+  /// A step the velocity model rejects is retried with half the time step at most this many times
+  /// before the run stops (0: stop at the first rejection).
+  int max_rejections = 5;
 };
 
 struct OutputSpec {
@@ -97,6 +104,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
 /// Read a case file, apply the overrides in order, validate.
 CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 
+// ---- setting up a run (case_setup.cpp) --------------------------------------------------------
 
 /// The surface S of the case (generated or read), without region labels.
 SurfaceMesh make_case_surface(const CaseConfig& config);

@@ -1,5 +1,5 @@
 #pragma once
-// Mesh generators: geodesic spheres, procedural terrains and terrains from DEM rasters.
+// Mesh generators: geodesic spheres, flat squares, procedural terrains and terrains from DEM rasters.
 #include <bodyfit/mesh.hpp>
 
 #include <cstdint>
@@ -19,6 +19,15 @@ struct SphereOptions {
 /// (20(a² + ab + b²) faces); counts with no geodesic sphere within 10 % (some below 300) get a
 /// Delaunay triangulation of N/2 + 2 points spread by Coulomb repulsion.
 SurfaceMesh make_sphere(const SphereOptions& options = {});
+
+struct PlaneOptions {
+  double size = 2;  ///< side of the square [-size/2, size/2]² at z = 0
+  double h = 0.05;  ///< target edge length
+};
+/// A flat open square triangulated with rows of near-equilateral triangles of edge ≈ h (odd rows
+/// shifted by half a cell; the end cells of those rows are the worst triangles, quality > 0.5):
+/// one boundary loop, normals +z, region label 2. Throws InputError for a non-positive size or h.
+SurfaceMesh make_plane(const PlaneOptions& options = {});
 
 /// A raster of heights: rows from north (top) to south, like an ESRI ASCII grid.
 struct HeightGrid {

@@ -7,8 +7,9 @@
 //   p.reject_unknown();  // "unknown key 'sped' in [model]; did you mean 'speed'?"
 //
 // Every getter records its key as known; reject_unknown() then refuses any other key of the table,
-// suggesting the closest known key. Errors are InputError naming the section, the key and the
-// expected value.
+// suggesting the closest known key. Errors are InputError naming where the value was written
+// ("case.toml:12: ", from toml++'s source region, when known), the section, the key and the
+// expected value: "case.toml:12: [model] speed: -1 is out of range [0, inf)".
 #include <bodyfit/velocity_model.hpp>
 
 #include <toml++/toml.h>
@@ -33,10 +34,16 @@ struct Range {
   std::string describe() const;  ///< "[0, inf)", "(0, 1]"
 };
 
+/// Where a TOML value was written, as a message prefix: "case.toml:12: ", "line 12: " for a table
+/// parsed from a string, "" when unknown (a value set by --set, a table built in code).
+std::string location_of(const toml::node& node);
+
 class Parameters {
  public:
   /// `section` names the table in messages ("model" gives "[model]").
   explicit Parameters(const toml::table& table, std::string section = "model");
+  /// An optional table: absent (nullptr) reads as an empty table, so every getter gives its fallback.
+  Parameters(const toml::table* table, std::string section);
 
   bool has(std::string_view key) const;
   /// A number (TOML integer or float), `fallback` when absent.
@@ -59,6 +66,8 @@ class Parameters {
   /// An array of numbers; `size` (when given) is the required length.
   std::vector<double> numbers(std::string_view key, std::vector<double> fallback,
                               std::optional<std::size_t> size = std::nullopt, Range range = {});
+  /// An array of arrays of `size` numbers each (points, axes: `[[x, y], ...]`); empty when absent.
+  std::vector<std::vector<double>> number_arrays(std::string_view key, std::size_t size, Range range = {});
   /// The sub-table `key` (empty when absent).
   const toml::table* table(std::string_view key);
 
@@ -67,12 +76,19 @@ class Parameters {
   void accept(const std::vector<ParameterInfo>& infos);
   /// Throw InputError for the first key of the table that no getter asked for.
   void reject_unknown() const;
+  /// Refuse keys that do not apply to the variant another key chose: "[surface] extent: does not
+  /// apply to generator 'sphere'" for forbid({"extent", ...}, "to generator 'sphere'").
+  void forbid(const std::vector<std::string>& keys, std::string_view reason) const;
+
+  /// Errors for checks no getter expresses (several keys together, a value set): located at the
+  /// key's value when present, else at the table; "[section] key: what" / "[section] what".
+  [[noreturn]] void fail(std::string_view key, const std::string& what) const;
+  [[noreturn]] void fail(const std::string& what) const;
 
   const std::string& section() const { return section_; }
 
  private:
   const toml::node* find(std::string_view key);
-  [[noreturn]] void fail(std::string_view key, const std::string& what) const;
 
   const toml::table& table_;
   std::string section_;

@@ -1,0 +1,121 @@
+// Setting up a run from a validated case: the surface S, its reference for the remesher, the
+// initial region G(0) meshed into T^0, and the evolution options.
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
+#include <bodyfit/projection.hpp>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace bodyfit {
+
+SurfaceMesh make_case_surface(const CaseConfig& config) {
+  const auto& s = config.surface;
+  switch (s.kind) {
+    case SurfaceSpec::Kind::File:
+      return read_mesh(s.file);
+    case SurfaceSpec::Kind::Sphere:
+      return make_sphere(s.sphere);
+    case SurfaceSpec::Kind::Terrain:
+      return s.dem.empty() ? make_terrain(s.terrain) : make_terrain_from_grid(read_dem(s.dem), s.terrain.h);
+    case SurfaceSpec::Kind::Plane:
+      return make_plane(s.plane);
+  }
+  return {};
+}
+
+ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surface) {
+  const auto& r = config.region;
+  ScalarField phi(surface.n_vertices());
+  switch (r.kind) {
+    case RegionSpec::Kind::Refs:
+      return {};
+    case RegionSpec::Kind::Sol:
+      return read_scalar_sol(r.sol, surface.n_vertices());
+    case RegionSpec::Kind::Cap: {
+      // Geodesic distance on a sphere of radius R: R·(polar angle − cap angle).
+      // For a union, the distance to the union is the min of the distances (exact outside).
+      for (auto v : surface.vertices()) {
+        Vec3 p = surface.point(v) - r.center;
+        double radius = p.norm();
+        double value = std::numeric_limits<double>::infinity();
+        for (const auto& [axis, angle] : r.caps) {
+          double beta = std::atan2(cross(p, axis).norm(), dot(p, axis));
+          value = std::min(value, radius * (beta - angle * std::numbers::pi / 180));
+        }
+        phi[v.idx()] = value;
+      }
+      return phi;
+    }
+    case RegionSpec::Kind::Disks: {
+      for (auto v : surface.vertices()) {
+        const Vec3& p = surface.point(v);
+        double d = std::numeric_limits<double>::infinity();
+        for (const auto& [cx, cy, radius] : r.disks) d = std::min(d, std::hypot(p[0] - cx, p[1] - cy) - radius);
+        phi[v.idx()] = d;
+      }
+      return phi;
+    }
+  }
+  return phi;
+}
+
+std::shared_ptr<const ReferenceSurface> make_case_reference(const CaseConfig& config, const SurfaceMesh& surface) {
+  if (config.surface.kind == SurfaceSpec::Kind::Sphere)
+    return ReferenceSurface::sphere(config.surface.sphere.center, config.surface.sphere.radius);
+  SurfaceMesh copy = surface;
+  copy.garbage_collection();
+  return std::make_shared<const ReferenceSurface>(copy);
+}
+
+CaseSetup setup_case(const CaseConfig& config) {
+  CaseSetup setup;
+  SurfaceMesh& mesh = setup.mesh;
+  mesh = make_case_surface(config);
+  mesh.garbage_collection();
+  EvolutionOptions& options = setup.options;
+  options.remesh = config.remesh;
+  // A landscape has no sharp features: on steep terrain many lattice edges exceed the 45° dihedral
+  // angle, and ridges detected there froze the remesher (minimum quality 0.06 instead of 0.6 on
+  // the fire cases). Feature detection stays off for terrains unless [remesh] angle is given.
+  if (config.surface.kind == SurfaceSpec::Kind::Terrain && !config.remesh_angle_given) options.remesh.feature_angle = 0;
+  options.remesh.reference = make_case_reference(config, mesh);
+  if (config.region.kind == RegionSpec::Kind::Refs) {
+    label_from_refs(config, mesh);
+    remesh(mesh, options.remesh);
+  } else {
+    mesh_initial_region(mesh, initial_level_set(config, mesh), config.discretize, options.remesh);
+  }
+  setup.h = config.remesh.hmax > 0 ? config.remesh.hmax : mean_edge_length(mesh);
+  options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * setup.h;
+  options.final_time = config.time.final_time;
+  options.max_cfl = config.time.max_cfl;
+  options.cfl_length = setup.h;
+  options.max_iterations = config.time.iterations;
+  options.distance = config.distance;
+  options.advection = config.advection;
+  options.discretize = config.discretize;
+  options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
+  return setup;
+}
+
+void label_from_refs(const CaseConfig& config, SurfaceMesh& surface) {
+  const auto& refs = config.region.refs;
+  std::size_t inside = 0;
+  for (auto f : surface.faces()) {
+    bool in = std::find(refs.begin(), refs.end(), surface.region(f)) != refs.end();
+    surface.region(f) = in ? kInside : kOutside;
+    inside += in;
+  }
+  if (inside == 0) throw InputError(fmt::format("[region] refs: no face of the surface carries refs [{}]", fmt::join(refs, ", ")));
+  update_interface_from_regions(surface);
+}
+
+}  // namespace bodyfit
