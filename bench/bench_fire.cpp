@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   fmt::print("{}: h = {} m, T^0 has {} triangles (setup {:.2f} s wall, {:.2f} s CPU)\n", case_file.string(), h,
              setup.mesh.n_faces(), setup_wall, setup_cpu);
 
-  setup.options.log = false;
+  EvolutionHooks hooks = EvolutionHooks::quiet();
   setup.options.max_iterations = iterations;
   if (max_cfl >= 0) setup.options.max_cfl = max_cfl;  // 0: one pass per step, as in the paper
   fmt::print("max_cfl = {} (0: no sub-steps)\n", setup.options.max_cfl);
@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
   StageTimes sum;
   double cpu_sum = 0;
   int count = 0;
-  setup.options.on_iteration = [&](const SurfaceMesh& mesh, const IterationRecord& r) {
+  hooks.on_iteration = [&](const SurfaceMesh& mesh, const IterationRecord& r, const RunState&) {
     const auto now = std::chrono::steady_clock::now();
     const double wall_ms = 1000 * std::chrono::duration<double>(now - last_wall).count();
     const double cpu_ms = 1000 * (cpu_seconds() - last_cpu);
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
     ++count;
     std::fflush(stdout);
   };
-  evolve(setup.mesh, model.model(), setup.options);
+  evolve(setup.mesh, model.model(), setup.options, {}, hooks);
   if (count > 0) {
     const double n = count;
     fmt::print("mean per iteration over {} iterations: {:.0f} ms (vel {:.0f}, dist {:.0f}, adv {:.0f}, disc {:.0f}, "

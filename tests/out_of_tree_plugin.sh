@@ -30,7 +30,7 @@ plugin="$work/plugin-build/bodyfit_windy.so"
 step "list it with the installed driver"
 listing=$(BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" plugins 2>&1) || { echo "$listing"; fail "bodyfit plugins"; }
 echo "$listing"
-grep -q "^windy 1.0  (ABI 1.0)" <<< "$listing" || fail "windy not listed"
+grep -q "^windy 2.0  (ABI 2.0)" <<< "$listing" || fail "windy not listed"
 grep -qF "file: $plugin" <<< "$listing" || fail "windy not listed with its file"
 grep -qF "wind = [1, 0, 0]" <<< "$listing" || fail "windy's parameters not listed"
 # The installed driver finds the installed conormal plugin beside its own library.
@@ -71,5 +71,23 @@ history="$work/run/history.csv"
 head -n1 "$history" | grep -q "max_speed" || { cat "$history"; fail "the model's metric is not in history.csv"; }
 [[ $(wc -l < "$history") -eq 4 ]] || { cat "$history"; fail "history.csv should have a header and rows for iterations 0, 1, 2"; }
 grep -q "windy_speed" "$work/run/step_00001.vtu" || fail "the model's point field is not in the VTU"
+grep -q 'Name="wind" NumberOfComponents="3"' "$work/run/step_00002.vtu" || fail "the model's vector field is not in the final VTU"
+
+step "the lifecycle: rejected steps, and state kept across an interrupted run"
+# max_growth 2 %: the first steps (|G| grows ~6 % at dt = 0.02) are rejected and retried with dt/2.
+lifecycle=(--set model.max_growth=0.02 --set time.iterations=4)
+BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" run "$work/case.toml" -o "$work/full" \
+  "${lifecycle[@]}" > "$work/full.log" 2>&1 || { cat "$work/full.log"; fail "lifecycle run"; }
+grep -q "rejected by model 'windy'" "$work/full.log" || { cat "$work/full.log"; fail "no rejection logged"; }
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "rejections") c = i } NR > 1 { s += $c } END { exit !(s > 0) }' \
+  "$work/full/history.csv" || { cat "$work/full/history.csv"; fail "no rejection counted in history.csv"; }
+BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" run "$work/case.toml" -o "$work/part" \
+  "${lifecycle[@]}" --set time.iterations=2 > "$work/part.log" 2>&1 || { cat "$work/part.log"; fail "first half"; }
+BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" run "$work/case.toml" -o "$work/part" \
+  "${lifecycle[@]}" --resume > "$work/rest.log" 2>&1 || { cat "$work/rest.log"; fail "resumed half"; }
+# The model's counter came back from the checkpoint: the last row says 4 accepted steps.
+column=$(head -n1 "$work/part/history.csv" | tr ',' '\n' | grep -n '^accepted_steps$' | cut -d: -f1)
+[[ $(tail -n1 "$work/part/history.csv" | cut -d, -f"$column") == 4 ]] || { cat "$work/part/history.csv"; fail "model state not restored"; }
+cmp -s "$work/part/final.mesh" "$work/full/final.mesh" || fail "the resumed run's final mesh differs"
 
 echo "out-of-tree plugin: OK"

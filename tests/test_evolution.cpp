@@ -36,8 +36,7 @@ Outcome run(const std::string& case_text, const std::vector<std::string>& overri
   LoadedModel model = load_model(config.model);
   configure_model(model, config.model_parameters);
   Outcome out{setup_case(config), {}};
-  out.setup.options.log = false;
-  out.result = evolve(out.setup.mesh, model.model(), out.setup.options);
+  out.result = evolve(out.setup.mesh, model.model(), out.setup.options, {}, EvolutionHooks::quiet());
   return out;
 }
 
@@ -160,79 +159,6 @@ TEST_CASE("a shrinking cap vanishes and the run stops with a clear reason") {
   CHECK(o.result.time < 0.25);
 }
 
-TEST_CASE("checkpoints round-trip bit-exactly") {
-  Outcome o = run(kPlane, {"time.iterations=1"});
-  std::stringstream buffer;
-  write_checkpoint(buffer, o.setup.mesh, 7, 0.125);
-  Checkpoint c = read_checkpoint(buffer);
-  CHECK(c.iteration == 7);
-  CHECK(c.time == 0.125);
-  REQUIRE(c.mesh.n_vertices() == o.setup.mesh.n_vertices());
-  REQUIRE(c.mesh.n_faces() == o.setup.mesh.n_faces());
-  for (auto v : c.mesh.vertices()) CHECK(c.mesh.point(v) == o.setup.mesh.point(v));
-  std::size_t interface = 0;
-  for (auto e : c.mesh.edges()) interface += c.mesh.interface(e);
-  CHECK(interface > 0);
-  CHECK(region_area(c.mesh, kInside) == region_area(o.setup.mesh, kInside));
-  std::stringstream garbage("not a checkpoint");
-  CHECK_THROWS_AS(read_checkpoint(garbage), InputError);
-}
-
-TEST_CASE("checkpoints restore the connectivity arrays exactly, reject corrupt ones, and read version 1") {
-  Outcome o = run(kPlane, {"time.iterations=1"});
-  const SurfaceMesh& mesh = o.setup.mesh;
-  std::stringstream buffer;
-  write_checkpoint(buffer, mesh, 1, 0.5);
-  const std::string bytes = buffer.str();
-  std::stringstream again(bytes);
-  const SurfaceMesh copy = read_checkpoint(again).mesh;
-  REQUIRE(copy.n_edges() == mesh.n_edges());
-  REQUIRE(copy.n_halfedges() == mesh.n_halfedges());
-  // Same element order everywhere (what makes a resumed run continue exactly).
-  for (auto h : mesh.halfedges()) {
-    CHECK(copy.to_vertex_handle(h) == mesh.to_vertex_handle(h));
-    CHECK(copy.next_halfedge_handle(h) == mesh.next_halfedge_handle(h));
-    CHECK(copy.prev_halfedge_handle(h) == mesh.prev_halfedge_handle(h));
-    CHECK(copy.face_handle(h) == mesh.face_handle(h));
-  }
-  for (auto v : mesh.vertices()) CHECK(copy.halfedge_handle(v) == mesh.halfedge_handle(v));
-  for (auto f : mesh.faces()) CHECK(copy.halfedge_handle(f) == mesh.halfedge_handle(f));
-
-  // A next-halfedge index pointing elsewhere: the first edge record follows the vertices
-  // (header 48 bytes, 42 per vertex); its first halfedge's "next" is 4 bytes into it.
-  std::string corrupt = bytes;
-  const std::size_t next_at = 48 + 42 * mesh.n_vertices() + 4;
-  std::int32_t wrong = 0;
-  std::memcpy(&wrong, corrupt.data() + next_at, 4);
-  wrong = (wrong + 7) % std::int32_t(mesh.n_halfedges());
-  std::memcpy(corrupt.data() + next_at, &wrong, 4);
-  std::stringstream bad(corrupt);
-  CHECK_THROWS_AS(read_checkpoint(bad), InputError);
-  std::stringstream truncated(bytes.substr(0, bytes.size() / 2));
-  CHECK_THROWS_AS(read_checkpoint(truncated), InputError);
-
-  // Version 1 (faces by corners), as session-1 runs wrote them: one triangle, one tagged edge.
-  std::string v1 = "BFCKPT01";
-  auto put = [&](const auto& value) { v1.append(reinterpret_cast<const char*>(&value), sizeof value); };
-  put(std::int64_t(3)), put(0.25), put(std::uint64_t(3)), put(std::uint64_t(1));
-  const double corners[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
-  for (const auto& p : corners) {
-    put(p[0]), put(p[1]), put(p[2]);
-    put(std::int32_t(0)), put(char(0)), put(char(0)), put(-1.0);
-  }
-  put(std::int32_t(0)), put(std::int32_t(1)), put(std::int32_t(2)), put(std::int32_t(kInside));
-  put(std::uint64_t(1));
-  put(std::int32_t(0)), put(std::int32_t(1)), put(std::int32_t(10)), put(char(1)), put(char(0)), put(char(0));
-  std::stringstream old(v1);
-  const Checkpoint c = read_checkpoint(old);
-  CHECK(c.iteration == 3);
-  CHECK(c.mesh.n_faces() == 1);
-  CHECK(c.mesh.region(FaceHandle(0)) == kInside);
-  std::size_t interface = 0;
-  for (auto e : c.mesh.edges()) interface += c.mesh.interface(e);
-  CHECK(interface == 1);
-}
-
 TEST_CASE("bodyfit run writes its outputs, and --resume gives the same final mesh") {
   test::TempDir dir("run");
   const std::string case_file = test::source_path("meshes/cases/plane_disk.toml").string();
@@ -287,9 +213,6 @@ TEST_CASE("[time] max_cfl: a long step is made of sub-steps on the same mesh, an
     CAPTURE(rec.iteration);
     CHECK(rec.substeps == 3);
     CHECK(rec.dt == doctest::Approx(0.15));
-    bool reported = false;
-    for (const auto& [name, value] : rec.metrics) reported |= name == "substeps" && value == 3;
-    CHECK(reported);
     const double radius = std::sqrt(rec.area / kPi);
     CHECK(std::abs(radius - (0.3 + rec.time)) < 0.3 * 0.05);
     CHECK(rec.components == 1);
@@ -298,5 +221,4 @@ TEST_CASE("[time] max_cfl: a long step is made of sub-steps on the same mesh, an
   // Without the cap, one pass per step.
   Outcome plain = run(kPlane, {"time.cfl=3.0"});
   CHECK(plain.result.records.front().substeps == 1);
-  for (const auto& [name, value] : plain.result.records.front().metrics) CHECK(name != "substeps");
 }

@@ -64,12 +64,11 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   options.max_iterations = steps;
   options.remesh = remesh;
   options.terrain = true;
-  options.log = false;
   options.output_dir = output_dir;
   options.max_cfl = max_cfl;
   options.cfl_length = remesh.hmax;
   FireRun run;
-  run.result = evolve(surface, model.model(), options);
+  run.result = evolve(surface, model.model(), options, {}, EvolutionHooks::quiet());
   if (!output_dir.empty()) model->finish(output_dir);
   run.mesh = std::move(surface);
   return run;

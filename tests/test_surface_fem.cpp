@@ -2,8 +2,8 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
-#include <bodyfit/step_context.hpp>
 #include <bodyfit/surface_fem.hpp>
+#include <bodyfit/velocity_model.hpp>
 
 #include "test_support.hpp"
 
@@ -170,10 +170,7 @@ double conormal_error(std::size_t faces, double* h) {
   SurfaceMesh sphere = make_sphere({.faces = faces});
   const double theta0 = 0.9;
   ScalarField d = field(sphere, [&](const Vec3& p) { return std::acos(std::clamp(p[2], -1.0, 1.0)) - theta0; });
-  StepState state;
-  state.mesh = &sphere;
-  state.distance = &d;
-  StepContext context = make_step_context(state);
+  StepContext context = StepContext::standalone(sphere, d);
   *h = context.mesh_size();
   const VectorField& n = context.conormal();
   double worst = 0;
@@ -204,9 +201,8 @@ TEST_CASE("StepContext conormal on a sphere cap points along e_theta within O(h)
 TEST_CASE("StepContext: state, cached geometry and helpers") {
   SurfaceMesh sphere = make_sphere({.faces = 1280});
   ScalarField d = field(sphere, [](const Vec3& p) { return p[2]; });
-  StepState state{.mesh = &sphere, .distance = &d, .time = 1.5, .dt = 0.25, .iteration = 7,
-                  .output_dir = "out", .terrain = false};
-  StepContext context = make_step_context(state);
+  StepContext context = StepContext::standalone(
+      sphere, d, {.time = 1.5, .dt = 0.25, .iteration = 7, .output_dir = "out", .terrain = false});
   CHECK(&context.mesh() == &sphere);
   CHECK(&context.distance() == &d);
   CHECK(context.time() == 1.5);

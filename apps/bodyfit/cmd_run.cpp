@@ -5,6 +5,7 @@
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
+#include <bodyfit/history.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/render.hpp>
@@ -31,70 +32,40 @@ struct RunArguments {
   std::string output_dir;
   std::vector<std::string> sets;
   bool resume = false;
+  std::string inject_signal;  ///< "N:INT" or "N:KILL": raise the signal after iteration N's checkpoint (tests)
 };
 
-const char* kHistoryColumns =
-    "iteration,time,dt,area,interface_length,components,min_quality,mean_quality,vertices,faces,"
-    "ms_velocity,ms_distance,ms_advect,ms_discretize,ms_remesh,ms_output,ms_total";
-
-/// history.csv: header + one row per state, rewritten atomically after every iteration.
-class History {
- public:
-  explicit History(fs::path file) : file_(std::move(file)) {}
-
-  /// Keep the rows of an earlier run up to `last_iteration` (for --resume).
-  void resume(int last_iteration) {
-    std::ifstream in(file_);
-    std::string line;
-    if (!std::getline(in, header_)) return;
-    while (std::getline(in, line)) {
-      if (line.empty()) continue;
-      if (std::stoi(line.substr(0, line.find(','))) <= last_iteration) rows_.push_back(line);
-    }
-  }
-  void add(const IterationRecord& r) {
-    if (header_.empty() || (metric_names_.empty() && !r.metrics.empty() && rows_.size() <= 1)) {
-      header_ = kHistoryColumns;
-      metric_names_.clear();
-      for (const auto& [name, value] : r.metrics) header_ += "," + name, metric_names_.push_back(name);
-    } else if (metric_names_.empty()) {
-      // After a resume: recover the metric names from the header.
-      std::stringstream ss(header_.substr(std::string(kHistoryColumns).size()));
-      for (std::string name; std::getline(ss, name, ',');)
-        if (!name.empty()) metric_names_.push_back(name);
-    }
-    std::string row = fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{},{:.6g},{:.6g},{},{},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f}",
-                                  r.iteration, r.time, r.dt, r.area, r.interface_length, r.components, r.min_quality,
-                                  r.mean_quality, r.vertices, r.faces, r.ms.velocity, r.ms.distance, r.ms.advect,
-                                  r.ms.discretize, r.ms.remesh, r.ms.output, r.ms.total());
-    for (const auto& name : metric_names_) {
-      row += ",";
-      for (const auto& [n, v] : r.metrics)
-        if (n == name) row += fmt::format("{:.10g}", v);
-    }
-    rows_.push_back(row);
-    write_atomically(file_, [&](std::ostream& out) {
-      out << header_ << "\n";
-      for (const auto& line : rows_) out << line << "\n";
-    });
-  }
-
- private:
-  fs::path file_;
-  std::string header_;
-  std::vector<std::string> metric_names_;
-  std::vector<std::string> rows_;
+/// The test hook of --inject-signal: the iteration and the signal it raises once that iteration
+/// is checkpointed (SIGINT exercises the clean stop, SIGKILL a crash between two iterations).
+struct InjectedSignal {
+  int iteration = -1;
+  int signal = 0;
 };
+InjectedSignal parse_injected_signal(const std::string& text) {
+  if (text.empty()) return {};
+  const auto colon = text.find(':');
+  const std::string what = colon == std::string::npos ? "" : text.substr(colon + 1);
+  InjectedSignal s;
+  try {
+    s.iteration = std::stoi(text.substr(0, colon));
+  } catch (const std::exception&) {
+    s.iteration = -1;
+  }
+  s.signal = what == "INT" ? SIGINT : what == "KILL" ? SIGKILL : 0;
+  if (s.iteration < 0 || s.signal == 0)
+    throw InputError(fmt::format("--inject-signal {}: expected ITERATION:INT or ITERATION:KILL", text));
+  return s;
+}
 
 std::vector<double> png_field(const CaseConfig& config, const StateView& s) {
   const auto& name = config.output.field;
   if (name == "region") return {};
   if (name == "d") return s.distance;
-  if (s.model_fields)
-    for (const auto& [n, values] : *s.model_fields)
+  if (s.model)
+    for (const auto& [n, values] : s.model->point_fields)
       if (n == name) return values;
   auto field = named_vertex_field(s.mesh, name);
-  if (field.empty() && s.model_fields) {
+  if (field.empty() && s.model) {
     static bool warned = false;
     if (!warned) spdlog::warn("[output] field '{}' is not known; colouring by region", name), warned = true;
   }
@@ -124,42 +95,56 @@ int run_case(const RunArguments& args) {
   const double h = setup.h;
   options.output_dir = outdir;
   options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
-  options.stop = &g_interrupted;
 
   const fs::path checkpoint = outdir / "checkpoint.bin";
-  History history(outdir / "history.csv");
+  RunHistory history(outdir / "history.csv");
   std::unique_ptr<PvdWriter> pvd;
+  RunState start;
   if (args.resume) {
     if (!fs::exists(checkpoint))
       throw InputError(fmt::format("--resume: no checkpoint in {} (run without --resume first)", outdir.string()));
     Checkpoint c = load_checkpoint(checkpoint);
     mesh = std::move(c.mesh);
-    options.start_iteration = c.iteration;
-    options.start_time = c.time;
-    history.resume(c.iteration);
-    pvd = std::make_unique<PvdWriter>(PvdWriter::resume(outdir / "series.pvd", c.time - 0.5 * options.dt));
-    spdlog::info("resuming from iteration {} (t = {})", c.iteration, c.time);
+    start = c.run;
+    if (c.model) {
+      model->load_state(*c.model);
+    } else {
+      spdlog::warn("{}: format {} checkpoint without model state: model '{}' starts afresh (results may differ "
+                   "from an uninterrupted run)",
+                   checkpoint.string(), c.format, model->name());
+    }
+    if (!history.resume(c.run.iteration)) {
+      if (c.run.iteration == 0) history.add(measure_state(mesh, 0, 0));  // killed before row 0 was written
+      else spdlog::warn("{}: rows missing before iteration {}", (outdir / "history.csv").string(), c.run.iteration);
+    }
+    pvd = std::make_unique<PvdWriter>(PvdWriter::resume(outdir / "series.pvd", c.run.time - 0.5 * options.dt));
+    spdlog::info("resuming from iteration {} (t = {})", c.run.iteration, c.run.time);
   } else {
     pvd = std::make_unique<PvdWriter>(outdir / "series.pvd");
-    save_checkpoint(checkpoint, mesh, 0, 0);
+    ModelState state;
+    model->save_state(state);
+    save_checkpoint(checkpoint, mesh, start, &state);
     history.add(measure_state(mesh, 0, 0));
   }
   spdlog::info("h = {:.4g}, dt = {:.4g}, final time {}, {} faces", h, options.dt, options.final_time, mesh.n_faces());
 
   const auto& out = config.output;
-  options.on_state = [&](const StateView& s) {
-    const bool last = s.velocity == nullptr;
-    if (out.vtu_every > 0 && (s.iteration % out.vtu_every == 0 || last)) {
+  EvolutionHooks hooks;
+  hooks.stop = &g_interrupted;
+  hooks.on_state = [&](const StateView& s) {
+    if (out.vtu_every > 0 && (s.iteration % out.vtu_every == 0 || s.final)) {
       VtuFields fields;
       fields.point_scalars.emplace_back("d", s.distance);
       if (s.velocity) fields.point_vectors.emplace_back("velocity", *s.velocity);
-      if (s.model_fields)
-        for (const auto& f : *s.model_fields) fields.point_scalars.push_back(f);
+      if (s.model) {
+        for (const auto& f : s.model->point_fields) fields.point_scalars.push_back(f);
+        for (const auto& f : s.model->vector_fields) fields.point_vectors.push_back(f);
+      }
       const std::string name = fmt::format("step_{:05d}.vtu", s.iteration);
       write_vtu(s.mesh, outdir / name, fields);
       pvd->add(s.time, name);
     }
-    if (out.png_every > 0 && (s.iteration % out.png_every == 0 || last)) {
+    if (out.png_every > 0 && (s.iteration % out.png_every == 0 || s.final)) {
       RenderOptions render_options;
       set_view(render_options, out.view);
       render_options.width = out.width, render_options.height = out.height;
@@ -169,12 +154,17 @@ int run_case(const RunArguments& args) {
       render_png(s.mesh, outdir / fmt::format("snap_{:05d}.png", s.iteration), render_options);
     }
   };
-  options.on_iteration = [&](const SurfaceMesh& m, const IterationRecord& r) {
+  const InjectedSignal inject = parse_injected_signal(args.inject_signal);
+  hooks.on_iteration = [&](const SurfaceMesh& m, const IterationRecord& r, const RunState& run) {
     history.add(r);
-    save_checkpoint(checkpoint, m, r.iteration, r.time);
+    ModelState state;
+    model->save_state(state);
+    save_checkpoint(checkpoint, m, run, &state);
+    if (r.iteration == inject.iteration) std::raise(inject.signal);
   };
 
-  EvolutionResult result = evolve(mesh, model.model(), options);
+  EvolutionResult result = evolve(mesh, model.model(), options, start, hooks);
+  if (history.rows() == 1) history.flush();
 
   if (result.reason == StopReason::Interrupted) {
     spdlog::warn("interrupted: iteration {} (t = {}) is complete and saved; continue with --resume", result.iteration,
@@ -183,6 +173,10 @@ int run_case(const RunArguments& args) {
   }
   write_mesh(mesh, outdir / "final.mesh");
   write_scalar_sol(outdir / "final.sol", result.final_distance);
+  if (result.reason == StopReason::Rejected) {
+    spdlog::error("stopped: {}; outputs in {}", result.message, outdir.string());
+    return 4;
+  }
   spdlog::info("done: {} after iteration {} (t = {}); outputs in {}", result.message, result.iteration, result.time,
                outdir.string());
   return 0;
@@ -195,6 +189,8 @@ bodyfit::cli::Command setup_run(CLI::App& app) {
   cmd->add_option("-o,--output", args->output_dir, "output directory (default: <case name>.out)");
   cmd->add_option("--set", args->sets, "override a key of the case, e.g. --set time.dt=0.05 (repeatable)");
   cmd->add_flag("--resume", args->resume, "continue from the last completed iteration in the output directory");
+  // A test hook (no group: hidden from --help): a crash or Ctrl-C at a known point of the run.
+  cmd->add_option("--inject-signal", args->inject_signal, "")->group("");
   return {cmd, [args]() { return run_case(*args); }};
 }
 

@@ -223,6 +223,12 @@ QualityStats quality_stats(const SurfaceMesh& mesh) {
   return s;
 }
 
+double mean_edge_length(const SurfaceMesh& mesh) {
+  double sum = 0;
+  for (auto e : mesh.edges()) sum += edge_length(mesh, e);  // as edge_length_stats, to the last bit
+  return mesh.n_edges() ? sum / double(mesh.n_edges()) : 0.0;
+}
+
 EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
   EdgeLengthStats s;
   s.min = std::numeric_limits<double>::infinity();

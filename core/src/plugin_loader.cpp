@@ -159,9 +159,9 @@ LoadedModel load_plugin_file(const fs::path& file) {
   auto abi_function = reinterpret_cast<AbiFunction>(require_symbol(guard.handle, file, "bodyfit_plugin_abi"));
   std::uint32_t abi = abi_function();
   if ((abi >> 16) != kPluginAbiMajor || (abi & 0xffffu) > kPluginAbiMinor)
-    throw file_error(file, fmt::format("plugin ABI {} is incompatible with this bodyfit (ABI {}): rebuild the plugin "
+    throw file_error(file, fmt::format("built against plugin ABI {}, this bodyfit needs {}.x (up to {}): rebuild it "
                                        "against bodyfit {}",
-                                       abi_string(abi), abi_string(kPluginAbi), config::version));
+                                       abi_string(abi), kPluginAbiMajor, abi_string(kPluginAbi), config::version));
   auto create = reinterpret_cast<CreateFunction>(require_symbol(guard.handle, file, "bodyfit_create"));
   auto destroy = reinterpret_cast<DestroyFunction>(require_symbol(guard.handle, file, "bodyfit_destroy"));
 

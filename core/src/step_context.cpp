@@ -1,5 +1,5 @@
 // StepContext: the read-only view a velocity model gets, with helpers computed on first use.
-#include <bodyfit/step_context.hpp>
+#include "step_state.hpp"
 
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/surface_fem.hpp>
@@ -61,6 +61,17 @@ StepContext make_step_context(const StepState& state) {
 
 StepContext::StepContext(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 StepContext::~StepContext() = default;
+StepContext::StepContext(StepContext&&) noexcept = default;
+
+StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& distance, const StandaloneStep& where) {
+  return make_step_context(StepState{.mesh = &mesh,
+                                     .distance = &distance,
+                                     .time = where.time,
+                                     .dt = where.dt,
+                                     .iteration = where.iteration,
+                                     .output_dir = where.output_dir,
+                                     .terrain = where.terrain});
+}
 
 const SurfaceMesh& StepContext::mesh() const { return *impl_->state.mesh; }
 const ScalarField& StepContext::distance() const { return *impl_->state.distance; }

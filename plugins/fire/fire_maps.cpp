@@ -1,5 +1,7 @@
 #include "fire_maps.hpp"
 
+#include <bodyfit/error.hpp>
+
 #include <bodyfit/geometry.hpp>
 
 #include <algorithm>
@@ -95,6 +97,28 @@ void ArrivalRaster::initialise(const SurfaceMesh& mesh, double cell_size, const 
   }
   grid_.nodata = -9999;
   grid_.heights.assign(grid_.cols * grid_.rows, std::numeric_limits<double>::quiet_NaN());
+}
+
+void ArrivalRaster::save(ModelState& state) const {
+  if (!initialised()) return;
+  state.set("arrival.size", std::vector<std::int64_t>{std::int64_t(grid_.cols), std::int64_t(grid_.rows)});
+  state.set("arrival.frame", std::vector<double>{grid_.x_origin, grid_.y_origin, grid_.cell_size, grid_.nodata});
+  state.set("arrival.times", grid_.heights);
+}
+
+void ArrivalRaster::load(const ModelState& state) {
+  grid_ = HeightGrid{};
+  if (!state.has("arrival.size")) return;
+  const auto& size = state.integers("arrival.size");
+  const auto& frame = state.numbers("arrival.frame");
+  const auto& times = state.numbers("arrival.times");
+  if (size.size() != 2 || frame.size() != 4 || size[0] <= 0 || size[1] <= 0 ||
+      times.size() != std::size_t(size[0]) * std::size_t(size[1]))
+    throw InputError("fire model state: the arrival-time raster is inconsistent");
+  grid_.cols = std::size_t(size[0]);
+  grid_.rows = std::size_t(size[1]);
+  grid_.x_origin = frame[0], grid_.y_origin = frame[1], grid_.cell_size = frame[2], grid_.nodata = frame[3];
+  grid_.heights = times;
 }
 
 void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next,

@@ -2,6 +2,7 @@
 // Spatial data of the fire model: wind fields, raster lookups and the arrival-time raster.
 #include <bodyfit/generators.hpp>
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/model_state.hpp>
 
 #include <filesystem>
 #include <string>
@@ -36,6 +37,10 @@ class ArrivalRaster {
   ScalarField sample_at_vertices(const SurfaceMesh& mesh) const;
   void write(const std::filesystem::path& file) const;
   const HeightGrid& grid() const { return grid_; }
+  /// Into / back from a checkpoint's model state (keys "arrival.*"); load leaves the raster
+  /// uninitialised when the state has none.
+  void save(ModelState& state) const;
+  void load(const ModelState& state);
 
  private:
   HeightGrid grid_;  ///< heights hold the arrival times (NaN = not reached)

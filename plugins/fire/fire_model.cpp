@@ -181,6 +181,26 @@ class FireModel final : public VelocityModel {
     if (arrival_.initialised()) arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt);
   }
 
+  // What a resumed run needs to continue exactly: the arrival times so far and the rotating wind's
+  // centre (taken from the first mesh's bounding box when the case does not give it).
+  void save_state(ModelState& state) const override {
+    state.version = 1;
+    arrival_.save(state);
+    if (wind_.has_center) state.set("wind.center", std::vector<double>{wind_.center[0], wind_.center[1], wind_.center[2]});
+  }
+
+  void load_state(const ModelState& state) override {
+    if (state.version != 1)
+      throw InputError(fmt::format("fire model state version {} (this plugin reads version 1)", state.version));
+    arrival_.load(state);
+    if (state.has("wind.center")) {
+      const auto& c = state.numbers("wind.center");
+      if (c.size() != 3) throw InputError("fire model state: wind.center needs 3 numbers");
+      wind_.center = Vec3(c[0], c[1], c[2]);
+      wind_.has_center = true;
+    }
+  }
+
   void finish(const std::filesystem::path& output_dir) override {
     if (arrival_.initialised() && !output_dir.empty()) arrival_.write(output_dir / "arrival_time.asc");
   }

@@ -1,14 +1,17 @@
 #pragma once
-// The evolution loop (Algorithm 1 of the paper). Iteration n, on the mesh T^n where G^n is
-// explicitly meshed (faces labelled kInside, interface edges tagged):
-//   1. d^n = signed distance to G^n; the model computes V^n (a normal speed v becomes v·n_Σ with
-//      the context's extended conormal);
-//   2-3. φ^{n+1} = advect(T^n, d^n, V^n, Δt); model.end_step(...);
-//   4. discretize(T^n, φ^{n+1}) then remesh → T^{n+1}.
-// With max_cfl > 0, steps 1-3 are repeated in sub-steps on T^n as the CFL cap asks, 4 runs once.
-// The loop stops at the final time or iteration count, when G vanishes or fills S, or when the
-// caller's stop flag is raised (checked between iterations, after that iteration's outputs).
+// The evolution loop (Algorithm 1 of the paper) as a step lifecycle. Step n, from the state T^n
+// where G^n is explicitly meshed (faces labelled kInside, interface edges tagged):
+//   1. decide whether to stop (final time, iteration count, interruption, G empty or full, the
+//      model's request);
+//   2. d^n and V^n (the model's compute; a normal speed v becomes v·n_Σ with the extended conormal),
+//      then φ^{n+1} = advect(T^n, d^n, V^n, Δt) — in CFL sub-steps on T^n when max_cfl asks;
+//   3. cut the zero level set of φ^{n+1} into T^n and remesh: the candidate T^{n+1};
+//   4. the model reviews the candidate (with d^{n+1}): accept, reject, stop, next Δt;
+//   5. accept: record, outputs, checkpoint (through the hooks); reject: restore T^n and retry with
+//      Δt/2, at most max_rejections times.
+// evolution.cpp reads the same way: one function per step.
 #include <bodyfit/advection.hpp>
+#include <bodyfit/checkpoint.hpp>
 #include <bodyfit/distance.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/mesh.hpp>
@@ -18,7 +21,6 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
-#include <iosfwd>
 #include <limits>
 #include <string>
 #include <utility>
@@ -28,8 +30,8 @@ namespace bodyfit {
 
 /// Wall-clock milliseconds spent in each stage of one iteration.
 struct StageTimes {
-  double velocity = 0, distance = 0, advect = 0, discretize = 0, remesh = 0, output = 0;
-  double total() const { return velocity + distance + advect + discretize + remesh + output; }
+  double velocity = 0, distance = 0, advect = 0, discretize = 0, remesh = 0, review = 0, output = 0;
+  double total() const { return velocity + distance + advect + discretize + remesh + review + output; }
 };
 
 /// One row of the history: the state T^n at time t^n and what it cost to produce it (row 0 is
@@ -42,26 +44,31 @@ struct IterationRecord {
   double interface_length = 0;    ///< |∂G|
   int components = 0;             ///< connected components of G
   int substeps = 1;               ///< sub-steps (1-3) that made this step (EvolutionOptions::max_cfl)
+  int rejections = 0;             ///< candidates of this step the model rejected before this one
   double min_quality = 0, mean_quality = 0;
   std::size_t vertices = 0, faces = 0;
   StageTimes ms;
-  std::vector<std::pair<std::string, double>> metrics;  ///< the model's, from VelocityField::metrics
+  /// The model's: VelocityField::metrics of T^n, then Review::metrics.
+  std::vector<std::pair<std::string, double>> metrics;
 };
 
 /// Measures of a mesh with regions (the geometric part of an IterationRecord).
 IterationRecord measure_state(const SurfaceMesh& mesh, int iteration, double time);
 
-/// What the output callback sees: T^n with d^n and V^n, before the level-set step of iteration n.
-/// For the last state (after the final iteration) `velocity` is null and d is that of T^N.
+/// What the output hook sees: a state T^n with d^n and V^n, before the level-set step of
+/// iteration n; for the final state V and the model's fields are those of one more compute() on
+/// it (when G is neither empty nor the whole surface; else null).
 struct StateView {
   const SurfaceMesh& mesh;
   int iteration;
   double time;
   const ScalarField& distance;
-  const VectorField* velocity;  ///< null for the final state
-  const std::vector<std::pair<std::string, ScalarField>>* model_fields;  ///< may be null
+  const VectorField* velocity;     ///< may be null (final state with no front)
+  const VelocityField* model;      ///< the model's fields and metrics (may be null)
+  bool final;                      ///< the last state of the run
 };
 
+/// How to evolve: what a case file sets.
 struct EvolutionOptions {
   double dt = 0;                 ///< time step (required, > 0); the last step is shortened to hit final_time
   /// Cap on the CFL number max|V|·Δt/h over the vertices (0: no cap). A step of `dt` whose
@@ -71,12 +78,12 @@ struct EvolutionOptions {
   /// of `dt`; the model's compute() and end_step() are called per sub-step (StepContext::dt is
   /// what remains of the step; the mesh, its regions and interface edges are those of T^n, the
   /// distance and the conormal those of the moved front), its metrics are those of the first.
+  /// A model with ModelNeeds::freeze_velocity is asked once per step and its V advects every sub-step.
   double max_cfl = 0;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   double final_time = std::numeric_limits<double>::infinity();
   long max_iterations = -1;      ///< stop when the iteration counter reaches this (−1: no limit)
-  int start_iteration = 0;       ///< counter and time of the input mesh (≠ 0 when resuming)
-  double start_time = 0;
+  int max_rejections = 5;        ///< retries (each with half the Δt) of a step the model rejects
   DistanceOptions distance;
   AdvectionOptions advection;
   /// Snapping in an evolution only within a hair (10⁻³ of an edge), or at vertices the remesher
@@ -88,18 +95,38 @@ struct EvolutionOptions {
   RemeshOptions remesh;          ///< set `reference` so that S never drifts
   std::filesystem::path output_dir;  ///< handed to the model (StepContext::output_dir, finish)
   bool terrain = false;          ///< S is a height field (StepContext::is_terrain)
-  /// Rebuild T^{n+1} from its arrays after each iteration, in the order a checkpoint is read back:
-  /// a run resumed from a checkpoint then continues exactly like the uninterrupted one.
+  /// Bring T^{n+1} to the form a checkpoint reads back (canonicalize) after each iteration, so a
+  /// run resumed from a checkpoint continues exactly like the uninterrupted one.
   bool canonical_order = true;
-  bool log = true;               ///< one spdlog info line per iteration
+};
+
+/// What the caller observes and controls while a run goes on.
+struct EvolutionHooks {
+  bool log = true;               ///< one spdlog info line per iteration (and per rejected step)
   const std::atomic<bool>* stop = nullptr;  ///< raised by the caller (e.g. SIGINT) to stop cleanly
   /// Output stage: called for every state T^n (see StateView); its time is counted as "output".
   std::function<void(const StateView&)> on_state;
-  /// Called after every completed iteration with T^{n+1} and its record (history, checkpoint).
-  std::function<void(const SurfaceMesh&, const IterationRecord&)> on_iteration;
+  /// Called after every accepted step with T^{n+1}, its record and where the run stands (for the
+  /// history and the checkpoint: RunState::dt is the Δt of the next step).
+  std::function<void(const SurfaceMesh&, const IterationRecord&, const RunState&)> on_iteration;
+
+  /// No log, no callbacks (tests, benchmarks).
+  static EvolutionHooks quiet() {
+    EvolutionHooks hooks;
+    hooks.log = false;
+    return hooks;
+  }
 };
 
-enum class StopReason { FinalTime, Iterations, Vanished, Filled, Interrupted };
+enum class StopReason {
+  FinalTime,
+  Iterations,
+  Vanished,
+  Filled,
+  Interrupted,
+  ModelStop,  ///< the model asked (Review::stop): converged, budget reached…
+  Rejected,   ///< the model rejected a step max_rejections + 1 times
+};
 const char* to_string(StopReason reason);
 
 struct EvolutionResult {
@@ -111,32 +138,14 @@ struct EvolutionResult {
   std::vector<IterationRecord> records;  ///< one per completed iteration (not the initial state)
 };
 
-/// Run Algorithm 1 on `mesh` (T^n with regions; modified in place into the final mesh).
-/// The model must be configured. Throws InputError when the input mesh has no region.
-EvolutionResult evolve(SurfaceMesh& mesh, VelocityModel& model, const EvolutionOptions& options);
+/// Run Algorithm 1 on `mesh` (the state `start` with regions; modified in place into the final
+/// mesh). The model must be configured (and its state loaded when resuming). Throws InputError
+/// when the input mesh has no region.
+EvolutionResult evolve(SurfaceMesh& mesh, VelocityModel& model, const EvolutionOptions& options,
+                       const RunState& start = {}, const EvolutionHooks& hooks = {});
 
 /// T^0: cut the zero level set of `phi` into `surface` and remesh it (the region of the case).
 void mesh_initial_region(SurfaceMesh& surface, const ScalarField& phi, const DiscretizeOptions& discretize,
                          const RemeshOptions& remesh);
-
-/// Mean edge length of a mesh (the h of Δt = c·h).
-double mean_edge_length(const SurfaceMesh& mesh);
-
-// ---- checkpoints -------------------------------------------------------------------------------
-// A binary snapshot of the state after a completed iteration: the mesh with every tag and φ, the
-// iteration counter and the time, with doubles stored bit-exactly.
-
-struct Checkpoint {
-  SurfaceMesh mesh;
-  int iteration = 0;
-  double time = 0;
-};
-void write_checkpoint(std::ostream& out, const SurfaceMesh& mesh, int iteration, double time);
-/// Atomically (write to a temporary, then rename).
-void save_checkpoint(const std::filesystem::path& file, const SurfaceMesh& mesh, int iteration, double time);
-Checkpoint read_checkpoint(std::istream& in, const std::string& name = "checkpoint");
-Checkpoint load_checkpoint(const std::filesystem::path& file);
-/// Rebuild `mesh` from its vertex and face arrays exactly as read_checkpoint would.
-void canonicalize(SurfaceMesh& mesh);
 
 }  // namespace bodyfit

@@ -65,6 +65,8 @@ struct EdgeLengthStats {
   std::size_t edges = 0;
 };
 EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh);
+/// Mean edge length (the h of Δt = c·h).
+double mean_edge_length(const SurfaceMesh& mesh);
 
 double total_area(const SurfaceMesh& mesh);
 /// Area of the faces whose region label equals `region`.

@@ -5,10 +5,18 @@
 //   uint32_t bodyfit_plugin_abi();            // kPluginAbi of the headers it was built with
 //   bodyfit::VelocityModel* bodyfit_create(); // a new model, owned by the caller
 //   void bodyfit_destroy(bodyfit::VelocityModel*);
-// The loader checks the ABI before calling anything else. A model is created once per run,
-// configured once from its TOML table, then compute() is called once per iteration of Algorithm 1
-// on the current mesh T^n. The model object lives for the whole run and may keep state.
+// The loader checks the ABI before calling anything else. A model is created once per run and
+// configured once from its TOML table; the model object lives for the whole run and may keep state.
+//
+// The life of one step n (docs/plugins.md has the whole picture):
+//   compute(T^n)            V^n (once per CFL sub-step, or once per step with needs().freeze_velocity)
+//   end_step(φ^{n+1} on T^n) after each advection, before the cut (optional)
+//   review(candidate T^{n+1}) accept / reject (the driver restores T^n and retries with Δt/2; only
+//                          with needs().may_reject) / stop the run / ask for the next Δt
+//   save_state / load_state  what the model keeps goes into every checkpoint and comes back on --resume
+//   finish(output_dir)      once, after the last state
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/model_state.hpp>
 
 #include <Eigen/SparseCore>
 #include <toml++/toml.h>
@@ -23,7 +31,7 @@
 
 namespace bodyfit {
 
-inline constexpr std::uint32_t kPluginAbiMajor = 1;
+inline constexpr std::uint32_t kPluginAbiMajor = 2;
 inline constexpr std::uint32_t kPluginAbiMinor = 0;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
@@ -43,8 +51,10 @@ struct VelocityField {
   ScalarField normal_speed;  ///< Kind::NormalSpeed: one value per vertex
   /// Scalars the driver adds as columns of history.csv (same names every iteration).
   std::vector<std::pair<std::string, double>> metrics;
-  /// Vertex fields the driver adds to this iteration's VTU.
+  /// Vertex fields the driver adds to this state's VTU (and may colour PNG snapshots with).
   std::vector<std::pair<std::string, ScalarField>> point_fields;
+  /// Vector vertex fields for the VTU (ParaView sees them as vectors).
+  std::vector<std::pair<std::string, VectorField>> vector_fields;
 
   static VelocityField tangential(VectorField v) {
     VelocityField f;
@@ -60,6 +70,14 @@ struct VelocityField {
   }
 };
 
+/// Where and when a StepContext made outside a run stands (StepContext::standalone).
+struct StandaloneStep {
+  double time = 0, dt = 0;
+  int iteration = 0;
+  std::filesystem::path output_dir;
+  bool terrain = false;
+};
+
 /// Read-only view of the state at iteration n, with the helpers a model needs. Geometric helpers
 /// are computed on first use and cached for the iteration.
 class StepContext {
@@ -67,6 +85,11 @@ class StepContext {
   struct Impl;
   explicit StepContext(std::unique_ptr<Impl> impl);
   ~StepContext();
+  StepContext(StepContext&&) noexcept;
+
+  /// A context outside a run (a model's unit tests, tools); `mesh` and `distance` must outlive it.
+  static StepContext standalone(const SurfaceMesh& mesh, const ScalarField& distance,
+                                const StandaloneStep& where = {});
   StepContext(const StepContext&) = delete;
   StepContext& operator=(const StepContext&) = delete;
 
@@ -100,14 +123,54 @@ class StepContext {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The state after the level-set step of iteration n (before remeshing): φ^{n+1} on T^n.
-/// Models that track something through time (arrival times, objective histories) use it.
+/// The state after one advection of step n (before the cut): φ^{n+1} on T^n. Models that track
+/// something through time (arrival times) use it. With CFL sub-steps there is one per sub-step.
 struct StepOutcome {
   const SurfaceMesh& mesh;          ///< T^n
-  const ScalarField& distance;      ///< d_{G^n}
-  const ScalarField& phi_next;      ///< φ^{n+1} at the vertices of T^n
-  double time;                      ///< t^n
-  double dt;
+  const ScalarField& distance;      ///< d at the start of this (sub-)step
+  const ScalarField& phi_next;      ///< φ at its end, at the vertices of T^n
+  double time;                      ///< time at the start of this (sub-)step
+  double dt;                        ///< its length
+  int attempt;                      ///< 0, then 1, 2… when the step is retried after a rejection
+};
+
+/// What a model needs from the driver (asked once, after configure).
+struct ModelNeeds {
+  /// The model may reject a candidate T^{n+1}: the driver keeps a copy of T^n during each step
+  /// (memory: about one more mesh) so it can restore it and retry with Δt/2.
+  bool may_reject = false;
+  /// With CFL sub-steps, compute V once per step on T^n and advect with it over every sub-step
+  /// (a PDE-based model solves once per step, not once per sub-step).
+  bool freeze_velocity = false;
+};
+
+/// A model's verdict on a candidate T^{n+1}.
+struct Review {
+  enum class Verdict { Accept, Reject };
+  Verdict verdict = Verdict::Accept;
+  std::string reason;    ///< why the candidate is rejected, or why the run stops
+  bool stop = false;     ///< end the run: after an accepted candidate T^{n+1} is the final state;
+                         ///< after a rejected one, T^n is
+  double next_dt = 0;    ///< Δt of the next step (0: keep the driver's); the last step is still
+                         ///< shortened to land on the final time
+  /// Columns added to the accepted state's history row (after compute()'s metrics).
+  std::vector<std::pair<std::string, double>> metrics;
+
+  static Review accept() { return {}; }
+  static Review reject(std::string why) {
+    Review r;
+    r.verdict = Verdict::Reject;
+    r.reason = std::move(why);
+    return r;
+  }
+  /// Accept the candidate and stop the run there (converged, budget reached…).
+  static Review accept_and_stop(std::string why) {
+    Review r;
+    r.stop = true;
+    r.reason = std::move(why);
+    return r;
+  }
+  bool accepted() const { return verdict == Verdict::Accept; }
 };
 
 class VelocityModel {
@@ -120,11 +183,22 @@ class VelocityModel {
   /// Validate and take the model's parameters (the [model] table of the case, without `name`).
   /// Throw InputError on an unknown key or a bad value, naming the key.
   virtual void configure(const toml::table& parameters) = 0;
+  /// What the model needs from the driver (see ModelNeeds). Default: nothing special.
+  virtual ModelNeeds needs() const { return {}; }
   /// V^n on the current mesh.
   virtual VelocityField compute(const StepContext& context) = 0;
-  /// Called after the advection of iteration n, before remeshing. Default: nothing.
+  /// Called after each advection (each sub-step, each attempt), before the cut. Default: nothing.
   virtual void end_step(const StepOutcome&) {}
-  /// Called once when the run ends (after the last iteration); may write files to output_dir.
+  /// The candidate T^{n+1} (cut and remeshed), as a context: its mesh, d_{G^{n+1}}, time t^n + Δt,
+  /// iteration n + 1, dt() the step tried. `attempt` counts earlier rejections of this step.
+  /// A rejection is honoured only when needs().may_reject. Default: accept.
+  virtual Review review(const StepContext& /*candidate*/, int /*attempt*/) { return Review::accept(); }
+  /// Put what the model must keep across a resume into `state` (called at every checkpoint).
+  virtual void save_state(ModelState& /*state*/) const {}
+  /// Restore it on --resume (after configure, before the first step). Throw InputError on a
+  /// state the model cannot read.
+  virtual void load_state(const ModelState& /*state*/) {}
+  /// Called once when the run ends (after the last state); may write files to output_dir.
   virtual void finish(const std::filesystem::path& /*output_dir*/) {}
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// Building the StepContext handed to VelocityModel::compute (the driver's side of the interface).
+// The driver's side of StepContext: what a context is built from (private to the core).
 #include <bodyfit/velocity_model.hpp>
 
 #include <filesystem>
@@ -15,7 +15,7 @@ struct StepState {
   bool terrain = false;                   ///< S is a height field z(x, y)
 };
 
-/// The context for one iteration; `state`'s pointers must outlive it.
+/// The context for one (sub-)step or candidate; `state`'s pointers must outlive it.
 StepContext make_step_context(const StepState& state);
 
 }  // namespace bodyfit

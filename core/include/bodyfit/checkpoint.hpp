@@ -1,0 +1,47 @@
+#pragma once
+// Checkpoints: a binary snapshot of a run after a completed iteration — the mesh with every tag and
+// φ, where the run stands (iteration, time, the Δt in force) and the velocity model's own state —
+// from which `bodyfit run --resume` continues exactly as the uninterrupted run would have.
+//
+// Doubles are stored bit-exactly and OpenMesh's connectivity arrays as they are, so reading restores
+// the very arrays that were written. Format 3 (this one) adds the Δt in force, the model state and a
+// checksum over everything before it; formats 1 and 2 are still read (then there is no model state).
+#include <bodyfit/mesh.hpp>
+#include <bodyfit/model_state.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+namespace bodyfit {
+
+/// Where a run stands between two iterations.
+struct RunState {
+  int iteration = 0;  ///< counter of the state
+  double time = 0;    ///< its time
+  double dt = 0;      ///< Δt of the next step (a model may have changed it; 0: the case's)
+};
+
+struct Checkpoint {
+  SurfaceMesh mesh;
+  RunState run;
+  std::optional<ModelState> model;  ///< absent in formats 1 and 2
+  int format = 3;                   ///< the format the file was written in
+};
+
+/// The mesh must be garbage-collected. `model` may be null (no model state stored).
+void write_checkpoint(std::ostream& out, const SurfaceMesh& mesh, const RunState& run, const ModelState* model = nullptr);
+/// Atomically (write to a temporary, then rename).
+void save_checkpoint(const std::filesystem::path& file, const SurfaceMesh& mesh, const RunState& run,
+                     const ModelState* model = nullptr);
+/// Throws InputError naming `name` for anything but an intact checkpoint of a known format.
+Checkpoint read_checkpoint(std::istream& in, const std::string& name = "checkpoint");
+Checkpoint load_checkpoint(const std::filesystem::path& file);
+
+/// Put `mesh` in the state a checkpoint reads back (garbage-collected, status flags cleared), so a
+/// run resumed from a checkpoint continues exactly like the uninterrupted one. Linear, no copy.
+void canonicalize(SurfaceMesh& mesh);
+
+}  // namespace bodyfit

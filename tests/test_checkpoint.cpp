@@ -1,0 +1,214 @@
+// Checkpoints: bit-exact round trips of the mesh, the run state and a model's state; corrupt and
+// truncated files refused; formats 1 and 2 still read; canonicalize() gives the mesh a checkpoint
+// reads back.
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/checkpoint.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/evolution.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/plugin_loader.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <sstream>
+
+using namespace bodyfit;
+
+namespace {
+
+const char* kPlane = R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.05
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.3]
+[model]
+name = "conormal"
+[time]
+cfl = 0.5
+iterations = 1
+[remesh]
+hmax = 0.05
+)";
+
+/// T^1 of a disk growing on a plane: a remeshed mesh with regions and an interface.
+SurfaceMesh evolved_plane() {
+  CaseConfig config = parse_case(toml::parse(kPlane));
+  LoadedModel model = load_model(config.model);
+  configure_model(model, config.model_parameters);
+  CaseSetup setup = setup_case(config);
+  evolve(setup.mesh, model.model(), setup.options, {}, EvolutionHooks::quiet());
+  return std::move(setup.mesh);
+}
+
+std::string bytes_of(const SurfaceMesh& mesh, const RunState& run, const ModelState* model) {
+  std::stringstream buffer;
+  write_checkpoint(buffer, mesh, run, model);
+  return buffer.str();
+}
+
+Checkpoint parse(const std::string& bytes) {
+  std::stringstream in(bytes);
+  return read_checkpoint(in);
+}
+
+std::string error_of(const std::string& bytes) {
+  try {
+    parse(bytes);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+/// The same checkpoint as format 2 wrote it (no Δt, no model state, no checksum): what runs made
+/// before the step lifecycle left on disk.
+std::string as_format_2(const std::string& v3, bool had_model_state) {
+  REQUIRE(!had_model_state);
+  std::string v2 = "BFCKPT02";
+  v2 += v3.substr(8, 16);    // iteration, time
+  v2 += v3.substr(32);       // counts and arrays (the Δt at 24..32 dropped)
+  v2.resize(v2.size() - 9);  // model-state flag and checksum
+  return v2;
+}
+
+void check_same_arrays(const SurfaceMesh& a, const SurfaceMesh& b) {
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  REQUIRE(a.n_edges() == b.n_edges());
+  REQUIRE(a.n_faces() == b.n_faces());
+  for (auto v : a.vertices()) {
+    CHECK(a.point(v) == b.point(v));
+    CHECK(a.phi(v) == b.phi(v));
+    CHECK(a.halfedge_handle(v) == b.halfedge_handle(v));
+    CHECK(a.status(v).bits() == b.status(v).bits());
+  }
+  for (auto h : a.halfedges()) {
+    CHECK(a.to_vertex_handle(h) == b.to_vertex_handle(h));
+    CHECK(a.next_halfedge_handle(h) == b.next_halfedge_handle(h));
+    CHECK(a.prev_halfedge_handle(h) == b.prev_halfedge_handle(h));
+    CHECK(a.face_handle(h) == b.face_handle(h));
+  }
+  for (auto e : a.edges()) {
+    CHECK(a.interface(e) == b.interface(e));
+    CHECK(a.status(e).bits() == b.status(e).bits());
+  }
+  for (auto f : a.faces()) {
+    CHECK(a.halfedge_handle(f) == b.halfedge_handle(f));
+    CHECK(a.region(f) == b.region(f));
+    CHECK(a.status(f).bits() == b.status(f).bits());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("checkpoints round-trip the mesh, the run state and the model state bit-exactly") {
+  const SurfaceMesh mesh = evolved_plane();
+  ModelState state;
+  state.version = 7;
+  state.set("dt", 0.1 + 0.2);  // not representable exactly in decimal: bits must survive
+  state.set("history", std::vector<double>{1.5, -2.25, 1e-300, std::numeric_limits<double>::infinity()});
+  state.set("counts", std::vector<std::int64_t>{-1, 0, std::int64_t(1) << 40});
+  state.set("raster", std::string("\0binary\xff", 8));
+  state.set("empty", std::vector<double>{});
+  const Checkpoint c = parse(bytes_of(mesh, {.iteration = 7, .time = 0.125, .dt = 0.0375}, &state));
+  CHECK(c.format == 3);
+  CHECK(c.run.iteration == 7);
+  CHECK(c.run.time == 0.125);
+  CHECK(c.run.dt == 0.0375);
+  REQUIRE(c.model);
+  CHECK(*c.model == state);
+  CHECK(c.model->number("dt") == 0.1 + 0.2);
+  CHECK(c.model->string("raster").size() == 8);
+  check_same_arrays(c.mesh, mesh);
+  CHECK(region_area(c.mesh, kInside) == region_area(mesh, kInside));
+
+  // Without a model state, and the accessors' errors.
+  CHECK_FALSE(parse(bytes_of(mesh, {}, nullptr)).model);
+  CHECK_THROWS_WITH_AS(state.number("nothing"), doctest::Contains("no entry 'nothing'"), InputError);
+  CHECK_THROWS_WITH_AS(state.number("history"), doctest::Contains("holds 4 numbers"), InputError);
+  CHECK_THROWS_WITH_AS(state.string("dt"), doctest::Contains("is not a string"), InputError);
+}
+
+TEST_CASE("damaged, truncated and altered checkpoints are refused before anything is allocated") {
+  const SurfaceMesh mesh = evolved_plane();
+  const std::string bytes = bytes_of(mesh, {.iteration = 1, .time = 0.5}, nullptr);
+  CHECK(error_of("not a checkpoint").find("not a bodyfit checkpoint") != std::string::npos);
+  // One flipped bit anywhere: the checksum.
+  for (std::size_t at : {std::size_t(9), std::size_t(60), bytes.size() / 2, bytes.size() - 3}) {
+    std::string damaged = bytes;
+    damaged[at] ^= 0x10;
+    CAPTURE(at);
+    CHECK(error_of(damaged).find("checksum mismatch") != std::string::npos);
+  }
+  CHECK(error_of(bytes.substr(0, bytes.size() / 2)).find("checksum mismatch") != std::string::npos);
+  CHECK(error_of(bytes.substr(0, 12)).find("checkpoint") != std::string::npos);
+
+  // Format 2 has no checksum: an altered vertex count is caught against the file length (it used
+  // to allocate gigabytes), a wrong "next" index by the connectivity checks.
+  std::string v2 = as_format_2(bytes, false);
+  std::string huge = v2;
+  const std::uint64_t count = std::uint64_t(1) << 30;
+  std::memcpy(huge.data() + 24, &count, 8);
+  CHECK(error_of(huge).find("corrupt checkpoint sizes") != std::string::npos);
+  std::string wrong_next = v2;
+  const std::size_t next_at = 48 + 42 * mesh.n_vertices() + 4;  // first edge record, first "next"
+  std::int32_t next = 0;
+  std::memcpy(&next, wrong_next.data() + next_at, 4);
+  next = (next + 7) % std::int32_t(mesh.n_halfedges());
+  std::memcpy(wrong_next.data() + next_at, &next, 4);
+  CHECK(error_of(wrong_next).find("corrupt checkpoint") != std::string::npos);
+}
+
+TEST_CASE("format 2 checkpoints (before the model state) and format 1 still load") {
+  const SurfaceMesh mesh = evolved_plane();
+  const Checkpoint c2 = parse(as_format_2(bytes_of(mesh, {.iteration = 4, .time = 0.2, .dt = 0.05}, nullptr), false));
+  CHECK(c2.format == 2);
+  CHECK(c2.run.iteration == 4);
+  CHECK(c2.run.time == 0.2);
+  CHECK(c2.run.dt == 0);  // not stored: the case's Δt applies
+  CHECK_FALSE(c2.model);
+  check_same_arrays(c2.mesh, mesh);
+
+  // Format 1 (faces by corners), as session-1 runs wrote them: one triangle, one tagged edge.
+  std::string v1 = "BFCKPT01";
+  auto put = [&](const auto& value) { v1.append(reinterpret_cast<const char*>(&value), sizeof value); };
+  put(std::int64_t(3)), put(0.25), put(std::uint64_t(3)), put(std::uint64_t(1));
+  const double corners[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (const auto& p : corners) {
+    put(p[0]), put(p[1]), put(p[2]);
+    put(std::int32_t(0)), put(char(0)), put(char(0)), put(-1.0);
+  }
+  put(std::int32_t(0)), put(std::int32_t(1)), put(std::int32_t(2)), put(std::int32_t(kInside));
+  put(std::uint64_t(1));
+  put(std::int32_t(0)), put(std::int32_t(1)), put(std::int32_t(10)), put(char(1)), put(char(0)), put(char(0));
+  const Checkpoint c1 = parse(v1);
+  CHECK(c1.format == 1);
+  CHECK(c1.run.iteration == 3);
+  CHECK(c1.mesh.n_faces() == 1);
+  CHECK(c1.mesh.region(FaceHandle(0)) == kInside);
+  std::size_t interface = 0;
+  for (auto e : c1.mesh.edges()) interface += c1.mesh.interface(e);
+  CHECK(interface == 1);
+}
+
+TEST_CASE("canonicalize gives the arrays a checkpoint reads back, without the round trip") {
+  // A remeshed mesh straight out of the remesher (deleted elements, status bits set), not yet
+  // canonical: canonicalize() must give exactly what decoding its checkpoint gives.
+  CaseConfig config = parse_case(toml::parse(kPlane));
+  CaseSetup setup = setup_case(config);
+  SurfaceMesh mesh = setup.mesh;
+  RemeshOptions options = setup.options.remesh;
+  options.hmax *= 0.7;  // real work: splits, collapses, flips
+  remesh(mesh, options);
+  for (auto v : mesh.vertices()) mesh.status(v).set_tagged(true);  // a stage leaving flags behind
+  canonicalize(mesh);
+  const Checkpoint read = parse(bytes_of(mesh, {}, nullptr));
+  check_same_arrays(mesh, read.mesh);
+  CHECK_FALSE(mesh.status(*mesh.vertices().begin()).tagged());
+}
