@@ -163,7 +163,16 @@ int run_case(const RunArguments& args) {
     if (r.iteration == inject.iteration) std::raise(inject.signal);
   };
 
-  EvolutionResult result = evolve(mesh, model.model(), options, start, hooks);
+  // An exception thrown in the plugin may carry a vtable of the plugin's own, which is unloaded
+  // when `model` goes out of scope: copy the message into an exception of ours while it is loaded.
+  EvolutionResult result;
+  try {
+    result = evolve(mesh, model.model(), options, start, hooks);
+  } catch (const InputError& e) {
+    throw InputError(e.what());
+  } catch (const std::exception& e) {
+    throw std::runtime_error(fmt::format("model '{}': {}", model->name(), e.what()));
+  }
   if (history.rows() == 1) history.flush();
 
   if (result.reason == StopReason::Interrupted) {

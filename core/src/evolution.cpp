@@ -124,7 +124,9 @@ class Evolution {
       distance_ = kept_distance;
       if (hooks_.log)
         spdlog::info("n={} step of dt={:.5g} rejected by model '{}': {}{}", n_ + 1, dt, model_.name(), review.reason,
-                     attempt < options_.max_rejections ? fmt::format("; retrying with dt={:.5g}", dt / 2) : "");
+                     review.stop ? std::string("; the model stops the run")
+                     : attempt < options_.max_rejections ? fmt::format("; retrying with dt={:.5g}", dt / 2)
+                                                          : std::string());
       rejections_ += 1;
       if (review.stop) {
         stop(StopReason::ModelStop, review.reason.empty() ? "the model stopped the run" : review.reason);
