@@ -90,7 +90,7 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
   if (!table.contains("region")) throw InputError("missing table [region] (shape = refs|sol|cap|disks)");
   Parameters p(table["region"].as_table(), "region");
   if (!p.has("shape")) p.fail("missing key 'shape' (refs, sol, cap or disks)");
-  const std::string shape = p.choice("shape", "", {"refs", "sol", "cap", "disks"});
+  const std::string shape = p.choice("shape", "", {"refs", "sol", "cap", "disks", "balls"});
   if (shape == "refs") {
     out.kind = RegionSpec::Kind::Refs;
     const auto refs = p.numbers("refs", {});
@@ -132,6 +132,16 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
       out.caps.emplace_back(out.axis, out.angle);
     }
     p.forbid({"refs", "sol", "centers", "radii"}, "to shape 'cap'");
+  } else if (shape == "balls") {
+    out.kind = RegionSpec::Kind::Balls;
+    const auto centers = p.number_arrays("centers", 3);
+    const auto radii = p.numbers("radii", {}, std::nullopt, kPositive);
+    if (!p.has("centers") || radii.empty()) p.fail("shape 'balls': needs 'centers' = [[x, y, z], ...] and 'radii'");
+    if (centers.size() != radii.size())
+      p.fail(fmt::format("centers and radii: {} centres but {} radii", centers.size(), radii.size()));
+    for (std::size_t i = 0; i < radii.size(); ++i)
+      out.balls.push_back({centers[i][0], centers[i][1], centers[i][2], radii[i]});
+    p.forbid({"refs", "sol", "axis", "angle", "axes", "angles", "center"}, "to shape 'balls'");
   } else {
     out.kind = RegionSpec::Kind::Disks;
     const auto centers = p.number_arrays("centers", 2);

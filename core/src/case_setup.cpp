@@ -54,6 +54,17 @@ ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surfa
       }
       return phi;
     }
+    case RegionSpec::Kind::Balls: {
+      // The Euclidean distance to the nearest ball's boundary (the run starts from the true signed
+      // geodesic distance to the region this cuts).
+      for (auto v : surface.vertices()) {
+        const Vec3& p = surface.point(v);
+        double d = std::numeric_limits<double>::infinity();
+        for (const auto& [cx, cy, cz, radius] : r.balls) d = std::min(d, (p - Vec3(cx, cy, cz)).norm() - radius);
+        phi[v.idx()] = d;
+      }
+      return phi;
+    }
     case RegionSpec::Kind::Disks: {
       for (auto v : surface.vertices()) {
         const Vec3& p = surface.point(v);

@@ -5,6 +5,7 @@
 //                seed, dem, max_height, feature_size) | "plane" (size, h)
 //   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
 //                degrees, center; or axes = [[..], ..] and angles = [..] for a union of caps) | "disks" (centers = [[x, y], ...], radii = [...])
+//                | "balls" (centers = [[x, y, z], ...], radii = [...]: S inside the balls)
 //   [model]      name = "conormal", every other key is the model's own parameter
 //   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, max_rejections
 //   [distance] [advection] [discretize] [remesh]   options of each stage
@@ -47,7 +48,7 @@ struct SurfaceSpec {
 };
 
 struct RegionSpec {
-  enum class Kind { Refs, Sol, Cap, Disks };
+  enum class Kind { Refs, Sol, Cap, Disks, Balls };
   Kind kind = Kind::Cap;
   std::vector<int> refs{kInside};   ///< Kind::Refs: face refs of the file that make up G
   std::filesystem::path sol;        ///< Kind::Sol: φ at the vertices of the surface (< 0 inside)
@@ -57,6 +58,7 @@ struct RegionSpec {
   std::vector<std::pair<Vec3, double>> caps;
   Vec3 center{0, 0, 0};             ///< Kind::Cap: centre of the sphere
   std::vector<std::array<double, 3>> disks;  ///< Kind::Disks: (x, y, radius), horizontal distance
+  std::vector<std::array<double, 4>> balls;  ///< Kind::Balls: (x, y, z, radius), the part of S in the balls
 };
 
 struct TimeSpec {
