@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <fstream>
 
 using namespace bodyfit;
 
@@ -168,4 +169,17 @@ TEST_CASE("the top view is a map: x (east) to the right, y (north) up") {
   CHECK(!is_inside(50, 50));    // upper left: north-west
   CHECK(!is_inside(150, 150));  // lower right: south-east
   CHECK(!is_inside(50, 150));   // lower left: south-west
+}
+
+TEST_CASE("bodyfit plot: columns of a history to a PNG; an unknown column names the known ones") {
+  bodyfit::test::TempDir dir("plot_command");
+  std::ofstream(dir / "history.csv") << "iteration,time,J\n0,0,nan\n1,0.1,2.5\n2,0.2,1.5\n3,0.3,1.25\n";
+  auto ok = bodyfit::test::run_bodyfit("plot " + (dir / "history.csv").string() + " -y J -y time -o " +
+                                       (dir / "J.png").string() + " --title J");
+  REQUIRE_MESSAGE(ok.exit_code == 0, ok.output);
+  CHECK(std::filesystem::file_size(dir / "J.png") > 1000);
+  auto bad = bodyfit::test::run_bodyfit("plot " + (dir / "history.csv").string() + " -y K -o " + (dir / "K.png").string());
+  CHECK(bad.exit_code == 1);
+  CHECK(bad.output.find("no column 'K' (columns: iteration, time, J)") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "K.png"));
 }
