@@ -374,3 +374,32 @@ hmax = 400.0
   // Spheres keep the default.
   CHECK(setup_case(parse(kValidCase)).options.remesh.feature_angle == 45);
 }
+
+TEST_CASE("balls: the Euclidean distance to the nearest sphere; bad balls are errors") {
+  const char* text = R"(
+[surface]
+generator = "sphere"
+faces = 320
+[region]
+shape = "balls"
+centers = [[0, 0, 1], [1, 0, 0]]
+radii = [0.5, 0.25]
+[model]
+name = "conormal"
+[time]
+dt = 0.1
+iterations = 1
+)";
+  CaseConfig c = parse(text);
+  CHECK(c.region.kind == RegionSpec::Kind::Balls);
+  SurfaceMesh sphere = make_case_surface(c);
+  ScalarField phi = initial_level_set(c, sphere);
+  for (auto v : sphere.vertices()) {
+    const Vec3& p = sphere.point(v);
+    const double expected = std::min((p - Vec3(0, 0, 1)).norm() - 0.5, (p - Vec3(1, 0, 0)).norm() - 0.25);
+    CHECK(phi[v.idx()] == doctest::Approx(expected).epsilon(1e-12));
+  }
+  CHECK_THROWS_WITH_AS(parse(text, {"region.radii=[0.5]"}), doctest::Contains("2 centres but 1 radii"), InputError);
+  CHECK_THROWS_WITH_AS(parse(text, {"region.centers=[[0, 0], [1, 0]]"}), doctest::Contains("centers"), InputError);
+  CHECK_THROWS_WITH_AS(parse(text, {"region.radii=[0.5, -1]"}), doctest::Contains("radii"), InputError);
+}
