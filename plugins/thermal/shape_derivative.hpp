@@ -1,0 +1,56 @@
+#pragma once
+// The objective J_ε(G) = T_ε(G) + ℓ|G| of the paper (4.13) and its shape derivative in band form:
+//
+//   J′_ε(G)(θ) = ∫_S w (θ·n_Σ)∘π_Σ ds + ℓ ∫_Σ θ·n_Σ dℓ,    w = −(1/ε²) h′(d_G/ε) u p,
+//
+// u, p the state and adjoint of thermal_fem.hpp with κ = h_ε(d_G), d_G the signed distance to G on S
+// (negative inside), π_Σ the projection onto Σ = ∂G. Derivation (docs/thermal_solvers.md): only
+// h_ε depends on G in the Lagrangian, and d_G′(θ) = −(θ·n_Σ)∘π_Σ. w ≤ 0 (h′ ≤ 0, u > 0, p < 0 for
+// f ≥ 0): growing G lowers T. The paper's printed (4.17) has the opposite sign and one more 1/ε.
+//
+// The velocity regularisation (H¹ on S) is not here: the core's H1Smoother does it.
+#include "quadrature.hpp"
+#include "thermal_fem.hpp"
+
+#include <bodyfit/mesh.hpp>
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace bodyfit::thermal {
+
+struct ObjectiveOptions {
+  double epsilon = 0;  ///< ε > 0 of h_ε (a length; required, InputError otherwise)
+  double ell = 0;      ///< ℓ ≥ 0, the weight of the area of G
+  /// Must be the quadrature of the solve (ThermalOptions::quadrature) for band_derivative to be the
+  /// exact derivative of the discrete J.
+  TriangleQuadrature quadrature{};
+  FaceMask neumann{};  ///< Γ_N (no Robin term there), per surface face; empty: Γ_N = ∅
+};
+
+struct ThermalObjective {
+  double J = 0;     ///< T + ℓ·area
+  double T = 0;     ///< mean temperature (1/|Ω|)∫_Ω u
+  double area = 0;  ///< |G|: area of the faces labelled inside
+  /// w at the surface vertices: −(1/ε²) h′(d/ε) u p (0 on vertices whose faces are all in Γ_N).
+  std::vector<double> density;
+};
+
+/// J_ε, T_ε, |G| and the shape-gradient density w at the vertices of `surface` (the skin the
+/// solution was computed on). `distance` is d_G at the surface vertices.
+ThermalObjective thermal_objective(const SurfaceMesh& surface, const std::vector<double>& distance,
+                                   const ThermalSolution& solution, const ObjectiveOptions& options);
+
+/// w_i = −(1/ε²) h′(d_i/ε) u_i p_i for the first distance.size() entries of u and p.
+std::vector<double> shape_gradient_density(const std::vector<double>& distance, const Eigen::VectorXd& u,
+                                           const Eigen::VectorXd& p, double epsilon);
+
+/// The derivative of the discrete T_ε when d_G moves to d_G + δ·s (s a P1 field on S):
+///   dT/dδ = ∫_{S\Γ_N} (dh_ε/dd)(d) s u p ds  = pᵀ (dR/dδ) u,
+/// integrated with the quadrature of the Robin assembly, so it is exact for the discrete problem
+/// (G's labels, hence ℓ|G|, do not change with d). For s = −(θ·n_Σ)∘π_Σ this is ∫_S w (θ·n_Σ)∘π_Σ.
+double band_derivative(const SurfaceMesh& surface, const std::vector<double>& distance,
+                       const std::vector<double>& s, const ThermalSolution& solution, const ObjectiveOptions& options);
+
+}  // namespace bodyfit::thermal
