@@ -1,0 +1,115 @@
+// Thermal shape optimisation: the time of one iteration split by stage, at several mesh sizes.
+//
+//   bench_thermal [--case meshes/cases/thermal_bracket_fine.toml] [--h 0.05,0.035,0.025]
+//                 [--iterations 8] [--solver conjugate_gradient] [-o thermal_timing.csv]
+//
+// For each h the case runs with remesh.hmax = h and epsilon = 2h; the medians over the iterations
+// of the driver's stages (velocity = the model's compute: regularisation, plus its solve on the first
+// state; review = tetrahedralisation, assembly, factorisation and solves of the candidate) and of the
+// model's own split (history.csv's ms_tetgen, ms_assembly, ms_factor, ms_solve, ms_regularise) are
+// printed and written as CSV, with the tetrahedra and surface triangles.
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/evolution.hpp>
+#include <bodyfit/plugin_loader.hpp>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+using namespace bodyfit;
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+std::vector<double> parse_list(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) out.push_back(std::stod(item));
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+  std::filesystem::path case_file = "meshes/cases/thermal_bracket_fine.toml", csv_file = "thermal_timing.csv";
+  std::vector<double> hs = {0.05, 0.035, 0.025};
+  int iterations = 8;
+  std::string solver = "conjugate_gradient";
+  const char* usage =
+      "usage: bench_thermal [--case file.toml] [--h 0.05,0.035,0.025] [--iterations 8] [--solver name] "
+      "[-o thermal_timing.csv]\n";
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) throw std::runtime_error(fmt::format("{} needs a value", argv[i]));
+      return argv[++i];
+    };
+    if (!std::strcmp(argv[i], "--case")) case_file = next();
+    else if (!std::strcmp(argv[i], "--h")) hs = parse_list(next());
+    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::stoi(next());
+    else if (!std::strcmp(argv[i], "--solver")) solver = next();
+    else if (!std::strcmp(argv[i], "-o")) csv_file = next();
+    else if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      fmt::print("{}", usage);
+      return 0;
+    } else {
+      fmt::print(stderr, "unknown argument '{}'\n{}", argv[i], usage);
+      return 2;
+    }
+  }
+  spdlog::set_level(spdlog::level::warn);
+  const std::vector<std::string> model_columns = {"ms_tetgen", "ms_assembly", "ms_factor", "ms_solve", "ms_regularise"};
+  std::ofstream csv(csv_file);
+  csv << "h,faces,tets,iterations,ms_velocity,ms_distance,ms_advect,ms_discretize,ms_remesh,ms_review,ms_total,"
+         "ms_tetgen,ms_assembly,ms_factor,ms_solve,ms_regularise\n";
+  fmt::print("{:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}  (median ms per iteration)\n", "h",
+             "faces", "tets", "tetgen", "assembly", "factor", "solve", "regul.", "remesh", "other", "review", "total");
+  for (double h : hs) {
+    CaseConfig config = read_case(case_file, {fmt::format("remesh.hmax={}", h), fmt::format("model.epsilon={}", 2 * h),
+                                              fmt::format("time.iterations={}", iterations),
+                                              fmt::format("model.solver=\"{}\"", solver), "model.patience=1000"});
+    LoadedModel model = load_model(config.model);
+    configure_model(model, config.model_parameters);
+    CaseSetup setup = setup_case(config);
+    std::map<std::string, std::vector<double>> samples;
+    EvolutionHooks hooks = EvolutionHooks::quiet();
+    hooks.on_iteration = [&](const SurfaceMesh& mesh, const IterationRecord& r, const RunState&) {
+      samples["faces"].push_back(double(mesh.n_faces()));
+      samples["ms_velocity"].push_back(r.ms.velocity);
+      samples["ms_distance"].push_back(r.ms.distance);
+      samples["ms_advect"].push_back(r.ms.advect);
+      samples["ms_discretize"].push_back(r.ms.discretize);
+      samples["ms_remesh"].push_back(r.ms.remesh);
+      samples["ms_review"].push_back(r.ms.review);
+      samples["ms_total"].push_back(r.ms.total());
+      for (const auto& [name, value] : r.metrics)
+        if (name == "tets" || std::find(model_columns.begin(), model_columns.end(), name) != model_columns.end())
+          samples[name].push_back(value);
+    };
+    evolve(setup.mesh, model.model(), setup.options, {}, hooks);
+    auto m = [&](const char* name) { return median(samples[name]); };
+    const double other = m("ms_distance") + m("ms_advect") + m("ms_discretize");
+    fmt::print("{:>7.4g} {:>7.0f} {:>7.0f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f} {:>8.1f}\n", h,
+               m("faces"), m("tets"), m("ms_tetgen"), m("ms_assembly"), m("ms_factor"), m("ms_solve"), m("ms_regularise"),
+               m("ms_remesh"), other, m("ms_review"), m("ms_total"));
+    csv << fmt::format("{},{:.0f},{:.0f},{},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f},{:.2f}\n",
+                       h, m("faces"), m("tets"), samples["ms_total"].size(), m("ms_velocity"), m("ms_distance"),
+                       m("ms_advect"), m("ms_discretize"), m("ms_remesh"), m("ms_review"), m("ms_total"), m("ms_tetgen"),
+                       m("ms_assembly"), m("ms_factor"), m("ms_solve"), m("ms_regularise"));
+  }
+  fmt::print("CSV: {}\n", csv_file.string());
+  return 0;
+} catch (const std::exception& e) {
+  fmt::print(stderr, "bench_thermal: {}\n", e.what());
+  return 1;
+}
