@@ -30,7 +30,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <memory>
 
 namespace bodyfit::thermal {
@@ -167,8 +166,13 @@ class ThermalModel final : public VelocityModel {
     } catch (const InputError& error) {
       // A candidate TetGen cannot mesh (a remeshing defect such as a degenerate triangle) is a bad
       // step, not the end of the run: the driver retries with a shorter one.
-      if (const char* dump = std::getenv("BODYFIT_THERMAL_DUMP")) write_mesh(candidate.mesh(), dump);
-      return Review::reject(fmt::format("the candidate cannot be tetrahedralised: {}", error.what()));
+      std::string kept;
+      if (!candidate.output_dir().empty()) {  // the mesh TetGen refused, for a bug report
+        const auto file = candidate.output_dir() / fmt::format("untetrahedralisable_{:05d}.mesh", candidate.iteration());
+        write_mesh(candidate.mesh(), file);
+        kept = fmt::format(" (kept as {})", file.string());
+      }
+      return Review::reject(fmt::format("the candidate cannot be tetrahedralised{}: {}", kept, error.what()));
     }
     const double J_next = next->objective.J;
     // Armijo's sufficient decrease, up to the noise of the discrete J: two meshes of the same G
