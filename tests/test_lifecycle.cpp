@@ -4,6 +4,7 @@
 // uninterrupted one.
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
+#include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
@@ -214,4 +215,9 @@ TEST_CASE("a fire run interrupted by SIGINT or kill -9 and resumed ends byte-ide
     CHECK(read_file(out / "final.mesh") == read_file(dir / "full" / "final.mesh"));
     CHECK(history_without_timings(out / "history.csv") == history_without_timings(dir / "full" / "history.csv"));
   }
+}
+
+TEST_CASE("a model returning NaN velocities is an error naming the model and the iteration, not a wrong region") {
+  CHECK_THROWS_WITH_AS(run("nan_at_vertex = 17"),
+                       doctest::Contains("model 'testlifecycle', iteration 0: non-finite velocity at vertex 17"), InputError);
 }

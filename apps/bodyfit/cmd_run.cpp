@@ -172,6 +172,8 @@ int run_case(const RunArguments& args) {
     throw InputError(e.what());
   } catch (const std::exception& e) {
     throw std::runtime_error(fmt::format("model '{}': {}", model->name(), e.what()));
+  } catch (...) {
+    throw std::runtime_error(fmt::format("model '{}' threw an exception that is not a std::exception", model->name()));
   }
   if (history.rows() == 1) history.flush();
 

@@ -58,6 +58,11 @@ VectorField velocity_of(VelocityField& field, const StepContext& context, std::s
   }
   if (velocity.size() != n)
     throw InputError(fmt::format("model '{}': {} velocities for {} vertices", model, velocity.size(), n));
+  // A NaN would pass through the advection and the cut silently and give a wrong region.
+  for (std::size_t i = 0; i < n; ++i)
+    if (!std::isfinite(velocity[i][0]) || !std::isfinite(velocity[i][1]) || !std::isfinite(velocity[i][2]))
+      throw InputError(fmt::format("model '{}', iteration {}: non-finite velocity at vertex {} ({}, {}, {})", model,
+                                   context.iteration(), i, velocity[i][0], velocity[i][1], velocity[i][2]));
   return velocity;
 }
 

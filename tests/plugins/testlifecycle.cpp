@@ -5,6 +5,7 @@
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/velocity_model.hpp>
 
+#include <cmath>
 #include <cstring>
 
 namespace {
@@ -36,6 +37,7 @@ class LifecycleModel final : public VelocityModel {
     stop_at_ = p.integer("stop_at", -1);
     grow_dt_ = p.number("grow_dt", 0, {.min = 0});
     freeze_ = p.boolean("freeze", false);
+    nan_at_ = p.integer("nan_at_vertex", -1, -1);
     p.reject_unknown();
   }
   ModelNeeds needs() const override { return {.may_reject = reject_every_ > 0, .freeze_velocity = freeze_}; }
@@ -43,6 +45,8 @@ class LifecycleModel final : public VelocityModel {
   VelocityField compute(const StepContext& context) override {
     ++computes_;
     auto field = VelocityField::normal(ScalarField(context.mesh().n_vertices(), speed_));
+    if (nan_at_ >= 0 && std::size_t(nan_at_) < field.normal_speed.size())  // a faulty model
+      field.normal_speed[std::size_t(nan_at_)] = std::nan("");
     field.metrics.emplace_back("computes", double(computes_));
     return field;
   }
@@ -86,6 +90,7 @@ class LifecycleModel final : public VelocityModel {
   std::int64_t reject_every_ = 0, stop_at_ = -1;
   double grow_dt_ = 0;
   bool freeze_ = false;
+  std::int64_t nan_at_ = -1;
   std::int64_t accepted_ = 0;
   std::int64_t computes_ = 0;
   int restore_mismatches_ = 0;
