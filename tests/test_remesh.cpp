@@ -491,3 +491,275 @@ TEST_CASE("a surface far more curved than the mesh: cuts, splits and moves proje
     CHECK(problems(mesh, vo) == "");
   }
 }
+
+namespace {
+
+/// A mesh from points and triangles (all outside).
+SurfaceMesh build_mesh(const std::vector<Vec3>& points, const std::vector<std::array<int, 3>>& triangles) {
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> vh;
+  for (const auto& p : points) vh.push_back(mesh.add_vertex(p));
+  for (const auto& t : triangles) mesh.add_face(vh[std::size_t(t[0])], vh[std::size_t(t[1])], vh[std::size_t(t[2])]);
+  for (auto f : mesh.faces()) mesh.region(f) = kOutside;
+  return mesh;
+}
+
+/// Rotation about the unit axis u by angle a (Rodrigues), applied to p.
+Vec3 rotate(const Vec3& p, const Vec3& u, double a) {
+  return p * std::cos(a) + (u % p) * std::sin(a) + u * ((u | p) * (1 - std::cos(a)));
+}
+
+}  // namespace
+
+TEST_CASE("a cap whose apex lies on its own ridge edge is repaired: the ridge runs through the apex") {
+  // The cube's ridge edge ab on the cube edge y = z = 1 loses one of its two triangles, (a, b, e), to
+  // (a, c, e) + (c, b, e) + the cap (a, b, c), with c on ab: a zero-area triangle. c is required (it
+  // cannot move or go), a and b slide only along the ridge: no collapse or move can repair the cap.
+  // Flipping ab to cd splits (b, a, d) at c; the ridge then runs a-c-b through the same points. As
+  // found on the thermal bracket (an interface vertex on a ridge, on the ridge edge of its cap). Also
+  // in a rotated copy, where the cap's area is rounding noise rather than 0, and with the top side
+  // z = 1 as G, so that ab is an interface edge too.
+  for (int variant = 0; variant < 3; ++variant) {
+    const bool rotated = variant == 1, with_interface = variant == 2;
+    INFO("variant " << variant);
+    const Vec3 axis = Vec3(1, 2, 3).normalized();
+    const double angle = rotated ? 0.7 : 0.0;
+    auto to_cube = [&](const Vec3& p) { return rotate(p, axis, -angle); };  // back to the axis-aligned cube
+    SurfaceMesh cube = make_cube(6);
+    std::vector<Vec3> points;
+    for (auto v : cube.vertices()) points.push_back(rotate(cube.point(v), axis, angle));
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<int> inside;
+    int a = -1, b = -1;
+    for (auto v : cube.vertices()) {
+      Vec3 p = cube.point(v);
+      if (std::abs(p[1] - 1) < 1e-12 && std::abs(p[2] - 1) < 1e-12 && std::abs(p[0] + 1.0 / 3) < 1e-12) a = v.idx();
+      if (std::abs(p[1] - 1) < 1e-12 && std::abs(p[2] - 1) < 1e-12 && std::abs(p[0]) < 1e-12) b = v.idx();
+    }
+    REQUIRE(a >= 0);
+    REQUIRE(b >= 0);
+    const int c = int(points.size());
+    points.push_back(points[std::size_t(a)] + (points[std::size_t(b)] - points[std::size_t(a)]) * 0.4);
+    bool capped = false;
+    for (auto f : cube.faces()) {
+      auto vs = face_vertices(cube, f);
+      std::array<int, 3> t{vs[0].idx(), vs[1].idx(), vs[2].idx()};
+      const int top = with_interface && std::abs(face_normal(cube, f)[2] - 1) < 1e-9;
+      // The face holding the halfedge a→b becomes (a, c, e), (c, b, e) and the cap (a, b, c).
+      int k = 0;
+      while (k < 3 && !(t[std::size_t(k)] == a && t[std::size_t((k + 1) % 3)] == b)) ++k;
+      if (k == 3) {
+        triangles.push_back(t);
+        inside.push_back(top);
+        continue;
+      }
+      const int e = t[std::size_t((k + 2) % 3)];
+      triangles.push_back({a, c, e});
+      triangles.push_back({c, b, e});
+      triangles.push_back({a, b, c});
+      inside.insert(inside.end(), 3, top);
+      capped = true;
+    }
+    REQUIRE(capped);
+    SurfaceMesh mesh = build_mesh(points, triangles);
+    mesh.required(VertexHandle(c)) = 1;
+    for (auto f : mesh.faces()) mesh.region(f) = inside[std::size_t(f.idx())] ? kInside : kOutside;
+    // The cube's edges are ridges (as a file's Ridges; the cap is a sliver: no ridge is detected
+    // next to it), the cap's sides a-c and c-b are not; the interface: between the two regions.
+    auto on_cube_edge = [&](const Vec3& p) {
+      Vec3 q = to_cube(p);
+      int at_one = 0;
+      for (int k = 0; k < 3; ++k) at_one += std::abs(std::abs(q[k]) - 1) < 1e-9;
+      return at_one >= 2;
+    };
+    for (auto e : mesh.edges()) {
+      auto h = mesh.halfedge_handle(e, 0);
+      Vec3 p = mesh.point(mesh.from_vertex_handle(h)), q = mesh.point(mesh.to_vertex_handle(h));
+      Vec3 pc = to_cube(p), qc = to_cube(q);
+      int shared = 0;
+      for (int k = 0; k < 3; ++k) shared += std::abs(std::abs(pc[k]) - 1) < 1e-9 && std::abs(pc[k] - qc[k]) < 1e-9;
+      bool at_c = mesh.from_vertex_handle(h).idx() == c || mesh.to_vertex_handle(h).idx() == c;
+      if (on_cube_edge(p) && on_cube_edge(q) && shared == 2 && !at_c) mesh.ridge(e) = 1;
+      if (mesh.region(mesh.face_handle(h)) != mesh.region(mesh.face_handle(mesh.opposite_halfedge_handle(h)))) {
+        mesh.interface(e) = 1;
+        mesh.edge_ref(e) = kInterfaceRef;
+      }
+    }
+    const Vec3 pc = mesh.point(VertexHandle(c));
+    {
+      auto before = validate_mesh(mesh);
+      REQUIRE(!before.ok());  // the cap is degenerate
+      CHECK(quality_stats(mesh).min < 1e-12);
+    }
+
+    RemeshOptions options;
+    options.hmax = 2.0 / 6;
+    auto report = remesh(mesh, options);
+
+    ValidateOptions vo;
+    vo.euler_characteristic = 2;
+    CHECK(problems(mesh, vo) == "");
+    CHECK(report.flips > 0);
+    CHECK(report.min_quality > 0.3);
+    // c is still there, where it was, on exactly two ridge edges, one on each side along the cube edge.
+    VertexHandle vc;
+    for (auto v : mesh.vertices())
+      if (mesh.point(v) == pc) vc = v;
+    REQUIRE(vc.is_valid());
+    std::vector<Vec3> ridge_ends;
+    int interface_edges = 0;
+    for (auto h : mesh.voh_range(vc)) {
+      if (mesh.ridge(mesh.edge_handle(h))) ridge_ends.push_back(mesh.point(mesh.to_vertex_handle(h)) - pc);
+      interface_edges += mesh.interface(mesh.edge_handle(h));
+    }
+    REQUIRE(ridge_ends.size() == 2);
+    CHECK((ridge_ends[0] | ridge_ends[1]) < 0);
+    CHECK((ridge_ends[0] % ridge_ends[1]).norm() < 1e-9 * ridge_ends[0].norm() * ridge_ends[1].norm());
+    // The ridges are still the cube's 12 edges, every vertex is on the cube; G is still the top side.
+    double ridge_length = 0;
+    for (auto e : mesh.edges())
+      if (mesh.ridge(e)) ridge_length += edge_length(mesh, e);
+    CHECK(ridge_length == doctest::Approx(24).epsilon(1e-9));
+    for (auto v : mesh.vertices()) {
+      Vec3 q = to_cube(mesh.point(v));
+      CHECK(std::max({std::abs(q[0]), std::abs(q[1]), std::abs(q[2])}) == doctest::Approx(1).epsilon(1e-9));
+    }
+    if (with_interface) {
+      CHECK(interface_edges == 2);
+      CHECK(interface_curves(mesh).closed == 1);
+      CHECK(region_area(mesh, kInside) == doctest::Approx(4).epsilon(1e-12));
+      CHECK(interface_length(mesh) == doctest::Approx(8).epsilon(1e-12));
+    }
+  }
+}
+
+TEST_CASE("an interface vertex projected onto a crease of S never makes a zero-area triangle with an edge on the crease") {
+  // S: a sheet folded by 30° along the x axis. The mesh: the same sheet, except that one interface
+  // vertex v (also the end of a ridge-tagged edge: locked, as cut vertices on the spurious ridges of
+  // the thermal bracket were) stands a little above the crease, on the triangle (k1, k0, v) whose
+  // side k0k1 lies on the crease (tagged as a ridge). The remesher puts the interface on S first:
+  // v's closest point on S is on the crease, on the segment k0k1, so that triangle would become a
+  // zero-area one whose normal is rounding noise, which passed the orientation test by chance (in
+  // 12 of the 24 rotations below). That move must be refused and no such triangle come out.
+  const double bend = M_PI / 6;
+  auto sheet = [&](double x, double u) {  // u < 0: the plane z = 0; u > 0: the plane bent down by 30°
+    return u <= 0 ? Vec3(x, u, 0) : Vec3(x, u * std::cos(bend), -u * std::sin(bend));
+  };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  int refused = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    INFO("trial " << trial);
+    Vec3 axis(uni(rng), uni(rng), uni(rng));
+    axis.normalize();
+    const double angle = 3 * uni(rng);
+    const Vec3 shift(uni(rng), uni(rng), uni(rng));
+    auto place = [&](const Vec3& p) { return rotate(p, axis, angle) + shift; };
+    // S: two triangles per half.
+    std::vector<Vec3> s_points;
+    for (double u : {-3.0, 0.0, 3.0})
+      for (double x : {-3.0, 4.0}) s_points.push_back(place(sheet(x, u)));
+    auto reference = std::make_shared<const ReferenceSurface>(
+        build_mesh(s_points, {{0, 1, 3}, {0, 3, 2}, {2, 3, 5}, {2, 5, 4}}));
+    // The mesh: unit cells (x, u) ∈ [-3, 4] × [-3, 3], the cell [0, 1] × [-1, 0] a fan around v.
+    const int nx = 8, nu = 7;
+    std::vector<Vec3> points;
+    for (int j = 0; j < nu; ++j)
+      for (int i = 0; i < nx; ++i) points.push_back(place(sheet(i - 3, j - 3)));
+    auto id = [&](int x, int u) { return (u + 3) * nx + (x + 3); };
+    const int v = int(points.size());
+    points.push_back(place(Vec3(0.5, 0.005, 0.05)));  // above the crease, inside the wedge of its normals
+    std::vector<std::array<int, 3>> triangles;
+    std::vector<int> inside;  // G: left of the curve (0, -3) … (0, -1) → v → (1, 0) … (1, 3)
+    for (int u = -3; u < 3; ++u)
+      for (int x = -3; x < 4; ++x) {
+        const int p00 = id(x, u), p10 = id(x + 1, u), p11 = id(x + 1, u + 1), p01 = id(x, u + 1);
+        if (x == 0 && u == -1) {
+          // k0 = (0, 0), k1 = (1, 0), r0 = (0, -1), r1 = (1, -1)
+          triangles.push_back({p01, p00, v});
+          inside.push_back(1);
+          triangles.push_back({p00, p10, v});
+          inside.push_back(0);
+          triangles.push_back({p10, p11, v});
+          inside.push_back(0);
+          triangles.push_back({p11, p01, v});
+          inside.push_back(1);
+          continue;
+        }
+        const int in = u < 0 ? x < 0 : x < 1;
+        triangles.push_back({p00, p10, p11});
+        triangles.push_back({p00, p11, p01});
+        inside.push_back(in);
+        inside.push_back(in);
+      }
+    SurfaceMesh mesh = build_mesh(points, triangles);
+    for (auto f : mesh.faces()) mesh.region(f) = inside[std::size_t(f.idx())] ? kInside : kOutside;
+    for (auto e : mesh.edges()) {
+      auto f0 = mesh.face_handle(mesh.halfedge_handle(e, 0)), f1 = mesh.face_handle(mesh.halfedge_handle(e, 1));
+      if (f0.is_valid() && f1.is_valid() && mesh.region(f0) != mesh.region(f1)) {
+        mesh.interface(e) = 1;
+        mesh.edge_ref(e) = kInterfaceRef;
+      }
+    }
+    for (auto w : mesh.vertices()) {
+      bool on_interface = false, in = false;
+      for (auto e : mesh.ve_range(w)) on_interface |= mesh.interface(e);
+      for (auto f : mesh.vf_range(w)) in |= mesh.region(f) == kInside;
+      mesh.phi(w) = on_interface ? 0.0 : in ? -1.0 : 1.0;
+    }
+    // The crease and the edge (v, r1) are ridges (v: interface and ridge, locked).
+    for (int x = -3; x < 4; ++x) mesh.ridge(mesh.edge_handle(mesh.find_halfedge(VertexHandle(id(x, 0)), VertexHandle(id(x + 1, 0))))) = 1;
+    mesh.ridge(mesh.edge_handle(mesh.find_halfedge(VertexHandle(v), VertexHandle(id(1, -1))))) = 1;
+    REQUIRE(problems(mesh) == "");
+    const Vec3 v_before = mesh.point(VertexHandle(v));
+
+    RemeshOptions options;
+    options.hmax = 1;
+    options.reference = reference;
+    remesh(mesh, options);
+    ValidateOptions vo;
+    vo.euler_characteristic = 1;
+    vo.boundary_loops = 1;
+    CHECK(problems(mesh, vo) == "");
+    CHECK(quality_stats(mesh).min > 1e-3);
+    for (auto w : mesh.vertices()) refused += mesh.point(w) == v_before;
+  }
+  MESSAGE(refused << " of 24 projections onto the crease refused");
+}
+
+TEST_CASE("ridges are detected only where S has a crease too: a bump of the mesh over a flat S adds none") {
+  // An evolving mesh can have sharp dihedral angles where S is smooth (triangles standing across a
+  // curved wall after cuts and moves, as on the bolt holes of the thermal bracket). Tagged as ridges,
+  // which are kept from step to step, they locked vertices off S and blocked the flips and collapses
+  // that repair such triangles: over the steps the mesh drifted off S by up to 3 hausd, grew fins and
+  // intersected itself. Here: a flat grid as S, and the mesh a copy with one vertex lifted by 1.5 h
+  // (its triangles at 56° to their flat neighbours, above the 45° feature angle).
+  SurfaceMesh flat = make_grid(10, 1.0);
+  auto reference = std::make_shared<const ReferenceSurface>(flat);
+  SurfaceMesh mesh = flat;
+  VertexHandle apex;
+  for (auto v : mesh.vertices())
+    if ((mesh.point(v) - Vec3(0.5, 0.5, 0)).norm() < 1e-12) apex = v;
+  REQUIRE(apex.is_valid());
+  mesh.set_point(apex, Vec3(0.5, 0.5, 0.15));
+  RemeshOptions options;
+  options.hmax = 0.1;
+  options.reference = reference;
+  remesh(mesh, options);
+  ValidateOptions vo;
+  vo.euler_characteristic = 1;
+  vo.boundary_loops = 1;
+  CHECK(problems(mesh, vo) == "");
+  std::size_t ridges = 0;
+  for (auto e : mesh.edges()) ridges += mesh.ridge(e);
+  CHECK(ridges == 0);
+  // Where the mesh is S itself, the dihedral test alone decides: the cube's 12 edges.
+  SurfaceMesh cube = make_cube(4);
+  RemeshOptions cube_options;
+  cube_options.hmax = 0.5;
+  remesh(cube, cube_options);
+  double ridge_length = 0;
+  for (auto e : cube.edges())
+    if (cube.ridge(e)) ridge_length += edge_length(cube, e);
+  CHECK(ridge_length == doctest::Approx(24).epsilon(1e-12));
+}

@@ -6,6 +6,7 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/projection.hpp>
 
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -57,6 +58,19 @@ constexpr int kRepairRounds = 5;
 constexpr char kSmoothRings = 3;
 // A relocation moving a vertex by more than this fraction of its size re-queues its ring.
 constexpr double kMoveSpread = 0.05;
+// A triangle whose doubled area is at most this fraction of its summed squared edge lengths is
+// degenerate: its cross product is rounding noise, so its "normal" may point anywhere (and pass any
+// orientation test by chance). It gets no normal and quality 0, which every check refuses.
+constexpr double kDegenerateArea = 1e-10;
+// No change may create a near-degenerate triangle: the worst triangle it makes stays above this
+// quality, or above half the worst one it replaces when that was already below it (the tests of the
+// passes and of the repair imply this; splits and the projection of the interface onto S check it).
+constexpr double kNearDegenerate = 1e-3;
+// A cap (a, b, c) whose apex c lies on its own feature edge ab, within this fraction of |ab|, is
+// repaired by flipping ab: the feature then runs a-c-b, through the same points.
+constexpr double kOnFeatureEdge = 1e-6;
+// After remesh, a triangle of area below this times max(its longest edge, hmin)² is reported.
+constexpr double kReportArea = 1e-12;
 
 struct Tri {
   double quality = 0;
@@ -68,7 +82,7 @@ Tri triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
   Vec3 n = (b - a) % (c - a);
   double twice_area = n.norm();
   double l2 = (b - a).sqrnorm() + (c - b).sqrnorm() + (a - c).sqrnorm();
-  if (twice_area > 0 && l2 > 0) {
+  if (l2 > 0 && twice_area > kDegenerateArea * l2) {
     t.normal = n / twice_area;
     t.quality = 2.0 * std::sqrt(3.0) * twice_area / l2;
   }
@@ -80,6 +94,10 @@ Tri triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
 struct Change {
   double old_min = 1, new_min = 1, old_sum = 0, new_sum = 0;
 };
+
+bool creates_near_degenerate(const Change& change) {
+  return change.new_min < std::min(kNearDegenerate, 0.5 * change.old_min);
+}
 
 // A changed triangle may turn by up to 45° from its old normal; a poor old triangle's normal says
 // little about S, so for one below kReliableNormal, 45° from S's normal there is enough too (folds
@@ -153,6 +171,9 @@ class Remesher {
   bool flip(EdgeHandle e);
   bool flip_check(EdgeHandle e, Change& change, Rule rule) const;
   void flip_edge(EdgeHandle e);
+  bool feature_flip_check(HalfedgeHandle h, Change& change) const;
+  void feature_flip(HalfedgeHandle h);
+  void classify_vertex(VertexHandle v);
   double relocate(VertexHandle v);
   bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
   bool move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const;
@@ -161,6 +182,7 @@ class Remesher {
              VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
   void repair_slivers();
   bool repair(FaceHandle f);
+  void report_degenerate() const;
   std::optional<std::pair<VertexHandle, VertexHandle>> curve_neighbours(VertexHandle v) const;
   Vec3 ring_centroid(VertexHandle v) const {
     Vec3 sum(0, 0, 0);
@@ -215,15 +237,27 @@ void Remesher::classify_features() {
     face_tri[i] = triangle(p[0], p[1], p[2]);
   });
   // Ridges by dihedral angle, added to the ridges read from the file; then the curve kind of edges.
+  // A ridge of the mesh must be a crease of S too: S's normals at the two faces differ as much. The
+  // evolving mesh has sharp dihedral angles where S has none (a triangle standing across a curved
+  // wall after cuts and moves); tagged as ridges there, they would lock vertices off S and block
+  // the flips and collapses that repair them, for good, since tags are kept from step to step.
+  // (When S is the mesh itself this is the dihedral test alone.)
   const bool detect = opt_.feature_angle > 0;
   const double cos_limit = std::cos(opt_.feature_angle * M_PI / 180.0);
+  auto s_normal = [&](FaceHandle f) {
+    auto p = face_points(m_, f);
+    return ref_->closest((p[0] + p[1] + p[2]) / 3.0).normal;
+  };
   tbb::parallel_for(0, ne, [&](int i) {
     EdgeHandle e(i);
-    if (detect && !m_.is_boundary(e)) {
-      const auto& t0 = face_tri[m_.face_handle(m_.halfedge_handle(e, 0)).idx()];
-      const auto& t1 = face_tri[m_.face_handle(m_.halfedge_handle(e, 1)).idx()];
+    if (detect && !m_.is_boundary(e) && !m_.ridge(e)) {
+      auto f0 = m_.face_handle(m_.halfedge_handle(e, 0)), f1 = m_.face_handle(m_.halfedge_handle(e, 1));
+      const auto& t0 = face_tri[f0.idx()];
+      const auto& t1 = face_tri[f1.idx()];
       // Slivers (e.g. fresh from discretize) have unreliable normals: no ridge from them.
-      if (t0.quality >= 1e-3 && t1.quality >= 1e-3 && (t0.normal | t1.normal) < cos_limit) m_.ridge(e) = 1;
+      if (t0.quality >= 1e-3 && t1.quality >= 1e-3 && (t0.normal | t1.normal) < cos_limit &&
+          (s_normal(f0) | s_normal(f1)) < cos_limit)
+        m_.ridge(e) = 1;
     }
     char c = kNoCurve;
     if (m_.required(e)) c = kRequiredCurve;
@@ -234,32 +268,7 @@ void Remesher::classify_features() {
   });
   tbb::parallel_for(0, nv, [&](int i) {
     VertexHandle v(i);
-    int count = 0;
-    char type = kNoCurve;
-    bool mixed = false, locked = m_.required(v) || m_.corner(v), angle_corner = false;
-    Vec3 dir[2];
-    for (auto h : m_.voh_range(v)) {
-      char c = m_.property(ecurve_, m_.edge_handle(h));
-      if (c == kNoCurve) continue;
-      if (c == kRequiredCurve) locked = true;
-      if (count > 0 && c != type) mixed = true;
-      type = c;
-      if (count < 2) dir[count] = m_.point(m_.to_vertex_handle(h)) - m_.point(v);
-      ++count;
-    }
-    if (m_.is_isolated(v)) locked = true;
-    if (count != 0 && count != 2) locked = true;
-    // The interface is the zero set of a sampled φ: its turns at the scale of fresh cuts are noise,
-    // so it has no angle corners; collapses along it are bounded by hausd instead (collapse_check).
-    if (count == 2 && !locked && !mixed && type != kInterfaceCurve) {
-      double n0 = dir[0].norm(), n1 = dir[1].norm();
-      // Turning angle between the two curve edges: π − angle(d0, d1).
-      double c = n0 > 0 && n1 > 0 ? -(dir[0] | dir[1]) / (n0 * n1) : -1;
-      angle_corner = std::acos(std::clamp(c, -1.0, 1.0)) > corner_angle_;
-    }
-    if (mixed) locked = true;
-    m_.property(kind_, v) = locked ? kLockedVertex : angle_corner ? kCornerVertex : (count == 2 ? kCurveVertex : kFreeVertex);
-    m_.property(vcurve_, v) = count == 2 ? type : kNoCurve;
+    classify_vertex(v);
     Vec3 normal(0, 0, 0);
     int hint = -1;
     if (ref_->analytic()) {
@@ -303,6 +312,36 @@ void Remesher::classify_features() {
   // through its vertices, not onto its chords (which would shrink convex regions at every remesh).
   // Ridges and boundaries are real polylines and stay so.
   curves_.smooth(kInterfaceCurve, corner_angle_);
+}
+
+// The kind of v (free, curve, corner, locked) and its curve, from the curve kinds of its edges.
+void Remesher::classify_vertex(VertexHandle v) {
+  int count = 0;
+  char type = kNoCurve;
+  bool mixed = false, locked = m_.required(v) || m_.corner(v), angle_corner = false;
+  Vec3 dir[2];
+  for (auto h : m_.voh_range(v)) {
+    char c = m_.property(ecurve_, m_.edge_handle(h));
+    if (c == kNoCurve) continue;
+    if (c == kRequiredCurve) locked = true;
+    if (count > 0 && c != type) mixed = true;
+    type = c;
+    if (count < 2) dir[count] = m_.point(m_.to_vertex_handle(h)) - m_.point(v);
+    ++count;
+  }
+  if (m_.is_isolated(v)) locked = true;
+  if (count != 0 && count != 2) locked = true;
+  // The interface is the zero set of a sampled φ: its turns at the scale of fresh cuts are noise,
+  // so it has no angle corners; collapses along it are bounded by hausd instead (collapse_check).
+  if (count == 2 && !locked && !mixed && type != kInterfaceCurve) {
+    double n0 = dir[0].norm(), n1 = dir[1].norm();
+    // Turning angle between the two curve edges: π − angle(d0, d1).
+    double c = n0 > 0 && n1 > 0 ? -(dir[0] | dir[1]) / (n0 * n1) : -1;
+    angle_corner = std::acos(std::clamp(c, -1.0, 1.0)) > corner_angle_;
+  }
+  if (mixed) locked = true;
+  m_.property(kind_, v) = locked ? kLockedVertex : angle_corner ? kCornerVertex : (count == 2 ? kCurveVertex : kFreeVertex);
+  m_.property(vcurve_, v) = count == 2 ? type : kNoCurve;
 }
 
 void Remesher::compute_sizing() {
@@ -451,6 +490,7 @@ bool Remesher::split(EdgeHandle e) {
   int region[2] = {0, 0};
   std::vector<FaceHandle> replaced;
   std::vector<std::array<VertexHandle, 3>> after;  // the new vertex is the invalid handle, at p
+  Change change;
   for (int s = 0; s < 2; ++s) {
     auto h = s == 0 ? h0 : h1;
     if (m_.is_boundary(h)) continue;
@@ -458,15 +498,18 @@ bool Remesher::split(EdgeHandle e) {
     region[s] = m_.region(m_.face_handle(h));
     auto from = m_.from_vertex_handle(h), to = m_.to_vertex_handle(h);
     Vec3 o = m_.point(opposite[s]);
-    Vec3 n_old = triangle(m_.point(from), m_.point(to), o).normal;
+    auto old_tri = triangle(m_.point(from), m_.point(to), o);
+    Vec3 n_old = old_tri.normal;
     if (n_old.sqrnorm() == 0) n_old = m_.property(vnormal_, a);
     auto t1 = triangle(m_.point(from), p, o), t2 = triangle(p, m_.point(to), o);
     if ((t1.normal | n_old) < 0.3 || (t2.normal | n_old) < 0.3) return false;
+    change.old_min = std::min(change.old_min, old_tri.quality);
+    change.new_min = std::min({change.new_min, t1.quality, t2.quality});
     replaced.push_back(m_.face_handle(h));
     after.push_back({from, VertexHandle(), opposite[s]});
     after.push_back({VertexHandle(), to, opposite[s]});
   }
-  if (folds(after, replaced, VertexHandle(), p)) return false;
+  if (creates_near_degenerate(change) || folds(after, replaced, VertexHandle(), p)) return false;
   // Edge attributes carried by the two halves.
   bool interface = m_.interface(e), ridge = m_.ridge(e);
   int ref = m_.edge_ref(e);
@@ -706,6 +749,69 @@ void Remesher::flip_edge(EdgeHandle e) {
   for (auto v : quad) mark_fresh(v);
 }
 
+// Whether the cap (a, b, c) of the halfedge h = a→b, whose apex c lies on its own feature edge ab,
+// is repaired by flipping ab. Nothing else can repair such a cap when c cannot move (an interface
+// vertex on a ridge, a required vertex: no collapse, no relocation) and a, b slide only along ab.
+// The flip to cd (d opposite ab in the other face) splits that face at c into (a, d, c) and
+// (c, d, b), in its own plane; the feature runs a-c-b, through the same points (feature_flip).
+bool Remesher::feature_flip_check(HalfedgeHandle h, Change& change) const {
+  auto e = m_.edge_handle(h);
+  if (m_.is_boundary(h) || m_.is_boundary(e) || m_.property(ecurve_, e) == kNoCurve) return false;
+  auto o = m_.opposite_halfedge_handle(h);
+  auto hn = m_.next_halfedge_handle(h);
+  // The cap's other sides become the two halves of ab: they must carry no feature of their own.
+  if (m_.property(ecurve_, m_.edge_handle(hn)) != kNoCurve ||
+      m_.property(ecurve_, m_.edge_handle(m_.next_halfedge_handle(hn))) != kNoCurve)
+    return false;
+  auto a = m_.from_vertex_handle(h), b = m_.to_vertex_handle(h);
+  auto c = m_.to_vertex_handle(hn), d = m_.to_vertex_handle(m_.next_halfedge_handle(o));
+  const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
+  const Vec3 ab = pb - pa;
+  const double l2 = ab.sqrnorm();
+  if (l2 <= 0) return false;
+  const double t = ((pc - pa) | ab) / l2;
+  if (!(t > 0 && t < 1) || (pa + ab * t - pc).norm() > kOnFeatureEdge * std::sqrt(l2)) return false;
+  if (!const_cast<SurfaceMesh&>(m_).is_flip_ok(e)) return false;
+  auto other = triangle(pb, pa, pd), t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
+  change.old_min = std::min(triangle(pa, pb, pc).quality, other.quality);
+  change.new_min = std::min(t0.quality, t1.quality);
+  if (change.new_min <= change.old_min + 1e-3) return false;
+  // The halves lie in the plane of the face they split (c is on its side ab).
+  if ((t0.normal | other.normal) < kFlipFlatness || (t1.normal | other.normal) < kFlipFlatness) return false;
+  return !folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h), m_.face_handle(o)});
+}
+
+void Remesher::feature_flip(HalfedgeHandle h) {
+  auto e = m_.edge_handle(h);
+  auto o = m_.opposite_halfedge_handle(h);
+  auto a = m_.from_vertex_handle(h), b = m_.to_vertex_handle(h);
+  auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h)), d = m_.to_vertex_handle(m_.next_halfedge_handle(o));
+  const bool interface = m_.interface(e), ridge = m_.ridge(e), required = m_.required(e);
+  const int ref = m_.edge_ref(e);
+  const char curve = m_.property(ecurve_, e);
+  const int region = m_.region(m_.face_handle(o));  // both new faces lie in the face (b, a, d)
+  m_.flip(e);  // e now joins c and d
+  m_.interface(e) = 0;
+  m_.ridge(e) = 0;
+  m_.required(e) = 0;
+  m_.edge_ref(e) = 0;
+  m_.property(ecurve_, e) = kNoCurve;
+  m_.property(estamp_, e) = 0;
+  for (auto w : {a, b}) {
+    auto half = m_.edge_handle(m_.find_halfedge(c, w));
+    m_.interface(half) = interface;
+    m_.ridge(half) = ridge;
+    m_.required(half) = required;
+    m_.edge_ref(half) = ref;
+    m_.property(ecurve_, half) = curve;
+  }
+  for (auto hh : {m_.halfedge_handle(e, 0), m_.halfedge_handle(e, 1)}) m_.region(m_.face_handle(hh)) = region;
+  if (curve == kInterfaceCurve) m_.phi(c) = 0;
+  classify_vertex(c);  // a vertex of the curve now (or locked, where it already had other features)
+  ++report_.flips;
+  for (auto v : {a, b, c, d}) mark_fresh(v);
+}
+
 double Remesher::relocate(VertexHandle v) {
   char kind = m_.property(kind_, v);
   if (kind == kLockedVertex || kind == kCornerVertex || m_.is_isolated(v)) return 0;
@@ -790,6 +896,7 @@ bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Cha
       if (len > 0 && (moved | other) < kFoldCos * len) return false;
     }
   }
+  if (creates_near_degenerate(change)) return false;
   // ... and against the moved face across (v, w1), the one whose spoke follows the opposite halfedge.
   for (int i = 0; i < n; ++i) {
     if (moved_normal[i].sqrnorm() == 0) continue;
@@ -829,7 +936,7 @@ void Remesher::repair_slivers() {
 }
 
 bool Remesher::repair(FaceHandle f) {
-  enum class Op { None, Collapse, Flip, Move } best_op = Op::None;
+  enum class Op { None, Collapse, Flip, FeatureFlip, Move } best_op = Op::None;
   double best = 0;
   HalfedgeHandle best_h;
   VertexHandle best_v;
@@ -849,6 +956,12 @@ bool Remesher::repair(FaceHandle f) {
     if (flip_check(m_.edge_handle(h), c, Rule::Repair) && consider(c)) {
       best = c.new_min;
       best_op = Op::Flip;
+      best_h = h;
+    }
+    Change cf;
+    if (feature_flip_check(h, cf) && consider(cf)) {
+      best = cf.new_min;
+      best_op = Op::FeatureFlip;
       best_h = h;
     }
   }
@@ -886,10 +999,33 @@ bool Remesher::repair(FaceHandle f) {
   switch (best_op) {
     case Op::Collapse: collapse_halfedge(best_h); return true;
     case Op::Flip: flip_edge(m_.edge_handle(best_h)); return true;
+    case Op::FeatureFlip: feature_flip(best_h); return true;
     case Op::Move: move_vertex(best_v, best_q, best_sp); return true;
     case Op::None: return false;
   }
   return false;
+}
+
+// Every operation refuses degenerate triangles and the repair removes those of its input it can: a
+// remaining one (a configuration no local operation repairs) is reported, never silently returned.
+void Remesher::report_degenerate() const {
+  std::size_t count = 0;
+  FaceHandle first;
+  double first_area = 0;
+  for (auto f : m_.faces()) {
+    auto p = face_points(m_, f);
+    double longest2 = std::max({(p[1] - p[0]).sqrnorm(), (p[2] - p[1]).sqrnorm(), (p[0] - p[2]).sqrnorm(), hmin_ * hmin_});
+    double area = 0.5 * ((p[1] - p[0]) % (p[2] - p[0])).norm();
+    if (area < kReportArea * longest2) {
+      if (count++ == 0) {
+        first = f;
+        first_area = area;
+      }
+    }
+  }
+  if (count > 0)
+    spdlog::warn("remesh: {} degenerate triangle(s) left (face {}: area {:.3g}); no local operation could repair them",
+                 count, first.idx(), first_area);
 }
 
 RemeshReport Remesher::run() {
@@ -985,6 +1121,7 @@ RemeshReport Remesher::run() {
   release();
   if (report_.collapses > 0) m_.garbage_collection();
   stamp("gc");
+  report_degenerate();
   auto q = quality_stats(m_);
   report_.min_quality = q.min;
   report_.mean_quality = q.mean;
