@@ -14,6 +14,7 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/surface_fem.hpp>
 
+#include <Eigen/SparseCholesky>
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
@@ -455,6 +456,62 @@ TEST_CASE("shape derivative: band formula against central finite differences of 
                         delta, fd, band, relative));
     CHECK(relative < 1e-3);
     CHECK(Jp < Jm);
+  }
+}
+
+TEST_CASE("Taylor test along the computed descent velocity: J(t) - J(0) - t J' = O(t^2), J' < 0") {
+  // The same cube and disk; v is the descent speed the plugin computes, (M + α²K) v = −M w,
+  // normalised to max |v| = 1. Moving Σ with normal speed v for a time t moves d by −t·v (labels
+  // fixed: only h_ε changes), so J(t) = J(0) + t·J′ + O(t²) with J′ = band_derivative(s = −v).
+  // Measured: J′ = −15.8, remainder / t² = 52.4, 52.7, 52.7, 52.8 for t = 0.02 … 0.0025.
+  auto s = make_box(16, {-1, -1, -1}, {1, 1, 1});
+  const double R = 0.45, eps = 0.15, alpha = 0.25;
+  for (auto f : s.faces()) {
+    auto [a, b, c] = face_points(s, f);
+    Vec3 centroid = (a + b + c) / 3;
+    bool top = a[2] == 1 && b[2] == 1 && c[2] == 1;
+    s.region(f) = top && std::hypot(centroid[0], centroid[1]) < R ? kInside : kOutside;
+  }
+  std::vector<double> d(s.n_vertices());
+  for (auto vh : s.vertices()) {
+    const Vec3& p = s.point(vh);
+    d[std::size_t(vh.idx())] = p[2] == 1 ? std::hypot(p[0], p[1]) - R : 10.0;
+  }
+  VolumeMesh volume = tetrahedralize(s, {.max_volume = regular_tet_volume(0.125)});
+  ThermalProblem problem;
+  problem.robin_field = d;
+  problem.robin_coefficient = [eps](double x) { return h_epsilon(x, eps); };
+  ThermalSolver solver(volume, problem);
+  ObjectiveOptions options{.epsilon = eps, .ell = 0};
+  const auto sol = solver.solve();
+  const auto objective = thermal_objective(s, d, sol, options);
+
+  const Eigen::SparseMatrix<double> M = mass_matrix(s), K = stiffness_matrix(s);
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(Eigen::SparseMatrix<double>(M + alpha * alpha * K));
+  const Eigen::Map<const Eigen::VectorXd> w(objective.density.data(), Eigen::Index(objective.density.size()));
+  Eigen::VectorXd v = -ldlt.solve(M * w);
+  v /= v.cwiseAbs().maxCoeff();
+  std::vector<double> minus_v(std::size_t(v.size()));
+  for (Eigen::Index i = 0; i < v.size(); ++i) minus_v[std::size_t(i)] = -v[i];
+  const double slope = band_derivative(s, d, minus_v, sol, options);
+  CHECK(slope < 0);  // a descent direction
+
+  auto J_at = [&](double t) {
+    std::vector<double> moved(d.size());
+    for (std::size_t i = 0; i < d.size(); ++i) moved[i] = d[i] - t * v[Eigen::Index(i)];
+    return thermal_objective(s, moved, solver.solve(moved), options).J;
+  };
+  std::vector<double> remainders;
+  for (double t : {0.02, 0.01, 0.005, 0.0025}) {
+    const double remainder = std::abs(J_at(t) - objective.J - t * slope);
+    MESSAGE(fmt::format("t = {}: J' = {:.6e}, |J(t) - J(0) - t J'| = {:.3e}, / t² = {:.4e}", t, slope, remainder, remainder / (t * t)));
+    remainders.push_back(remainder);
+  }
+  for (std::size_t k = 1; k < remainders.size(); ++k) {
+    const double ratio = remainders[k] / remainders[k - 1];  // 1/4 for a second-order remainder
+    CAPTURE(k);
+    CHECK(ratio > 0.2);
+    CHECK(ratio < 0.3);
   }
 }
 

@@ -68,8 +68,16 @@ TEST_CASE("thermal optimisation on a sphere: J decreases at every accepted step,
           "with half the step, and a resume continues exactly") {
   bodyfit::test::TempDir dir("thermal_sphere");
   const std::string case_file = write_case(dir, kSphere);
-  auto run = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "full").string());
+  auto run = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "full").string() +
+                                        " --set model.volume_every=4");
   REQUIRE_MESSAGE(run.exit_code == 0, run.output);
+  // The volume series: tetrahedra with the temperature inside, in a ParaView collection.
+  CHECK(std::filesystem::exists(dir / "full" / "volume.pvd"));
+  std::ifstream volume(dir / "full" / "volume_00004.vtu");
+  std::stringstream vtu;
+  vtu << volume.rdbuf();
+  CHECK(vtu.str().find("Name=\"temperature\"") != std::string::npos);
+  CHECK(vtu.str().find("NumberOfCells=") != std::string::npos);
   const Table rows = read_csv(dir / "full" / "history.csv");
   REQUIRE(rows.size() >= 5);
   double previous = std::nan("");
