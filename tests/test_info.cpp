@@ -139,3 +139,17 @@ TEST_CASE("info: a terrain from the DEM fixture covers the raster's extent with 
   CHECK(missing.exit_code == 1);
   CHECK(missing.output.find("none.asc") != std::string::npos);
 }
+
+TEST_CASE("command line: MMG's -hmax spellings work as in mmgs, usage errors exit 2") {
+  bodyfit::test::TempDir dir("cli_mmg");
+  const std::string sphere = (dir / "s.mesh").string();
+  REQUIRE(bodyfit::test::run_bodyfit("mesh sphere --faces 320 -o " + sphere).exit_code == 0);
+  // Read by CLI11 as -h -m -a -x, this used to print the help and exit 0 without writing anything.
+  auto mmg = bodyfit::test::run_bodyfit("remesh " + sphere + " -hmax 0.3 -hausd 0.01 -o " + (dir / "r.mesh").string());
+  CHECK_MESSAGE(mmg.exit_code == 0, mmg.output);
+  CHECK(std::filesystem::exists(dir / "r.mesh"));
+  auto unknown = bodyfit::test::run_bodyfit("remesh " + sphere + " --hmaxx 0.3 -o " + (dir / "x.mesh").string());
+  CHECK(unknown.exit_code == 2);
+  CHECK_FALSE(std::filesystem::exists(dir / "x.mesh"));
+  CHECK(bodyfit::test::run_bodyfit("remesh --help").exit_code == 0);
+}

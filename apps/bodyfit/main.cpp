@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <string>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -50,10 +51,18 @@ int main(int argc, char** argv) {
   std::vector<cli::Command> added;
   for (auto& [order, setup] : commands) added.push_back(setup(app));
 
+  // MMG's spellings (-hmax 0.1): CLI11 would read "-hmax" as the flags -h -m -a -x, print the
+  // help and exit 0 — a script written for mmgs would carry on as if the stage had run.
+  std::vector<std::string> arguments(argv + 1, argv + argc);
+  for (auto& a : arguments)
+    if (a == "-hmax" || a == "-hmin" || a == "-hausd" || a == "-hgrad") a = "-" + a;
+  std::reverse(arguments.begin(), arguments.end());  // CLI11 takes the arguments in reverse
+
   try {
-    app.parse(argc, argv);
+    app.parse(arguments);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    const int code = app.exit(e);  // prints help, version or the error
+    return code == 0 ? 0 : 2;      // a usage error is exit code 2, not CLI11's 105-114
   }
 
   auto logger = spdlog::stderr_color_mt("bodyfit");
