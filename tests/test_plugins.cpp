@@ -59,7 +59,9 @@ TEST_CASE("a good plugin loads, configures and computes") {
 
   SurfaceMesh sphere = make_sphere({.faces = 320});
   ScalarField d(sphere.n_vertices(), 0.0);
-  StepContext context = StepContext::standalone(sphere, d, {.iteration = 4});
+  StandaloneStep where;
+  where.iteration = 4;
+  StepContext context = StepContext::standalone(sphere, d, where);
   VelocityField v = model->compute(context);
   CHECK(v.kind == VelocityField::Kind::NormalSpeed);
   REQUIRE(v.normal_speed.size() == sphere.n_vertices());
