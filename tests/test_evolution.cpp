@@ -83,13 +83,6 @@ final_time = 0.3
 hmax = 0.05
 )";
 
-std::string read_file(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 }  // namespace
 
 TEST_CASE("sphere cap under the conormal flow (paper §4.2): error bound and final angle π/2") {
@@ -143,7 +136,7 @@ TEST_CASE("an interface that meets the boundary of an open surface: a half-disk 
 }
 
 TEST_CASE("two caps grow and merge: components 2 → 1") {
-  Outcome o = run(read_file(test::source_path("meshes/cases/two_caps_merge.toml")), {"surface.h=0.08", "remesh.hmax=0.08"});
+  Outcome o = run(test::read_file(test::source_path("meshes/cases/two_caps_merge.toml")), {"surface.h=0.08", "remesh.hmax=0.08"});
   REQUIRE(!o.result.records.empty());
   CHECK(o.result.records.front().components == 2);
   CHECK(o.result.records.back().components == 1);
@@ -171,7 +164,7 @@ TEST_CASE("bodyfit run writes its outputs, and --resume gives the same final mes
                         "step_00004.vtu", "snap_00000.png", "snap_00004.png"})
     CHECK_MESSAGE(std::filesystem::exists(dir / "full" / f), f);
   // history.csv: header + the initial state + 4 iterations.
-  std::stringstream history(read_file(dir / "full" / "history.csv"));
+  std::stringstream history(test::read_file(dir / "full" / "history.csv"));
   std::string line;
   int rows = 0;
   std::getline(history, line);
@@ -179,7 +172,7 @@ TEST_CASE("bodyfit run writes its outputs, and --resume gives the same final mes
   while (std::getline(history, line)) ++rows;
   CHECK(rows == 5);
   // The effective case carries the overrides.
-  CHECK(read_file(dir / "full" / "case.toml").find("iterations = 4") != std::string::npos);
+  CHECK(test::read_file(dir / "full" / "case.toml").find("iterations = 4") != std::string::npos);
 
   // Interrupted after 2 iterations, then resumed up to 4.
   auto part = test::run_bodyfit("run " + case_file + " -o " + (dir / "resumed").string() + common +
@@ -189,9 +182,9 @@ TEST_CASE("bodyfit run writes its outputs, and --resume gives the same final mes
                                 " --set time.iterations=4 --resume");
   REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
   CHECK(rest.output.find("resuming from iteration 2") != std::string::npos);
-  CHECK(read_file(dir / "resumed" / "final.mesh") == read_file(dir / "full" / "final.mesh"));
-  CHECK(read_file(dir / "resumed" / "final.sol") == read_file(dir / "full" / "final.sol"));
-  std::stringstream resumed_history(read_file(dir / "resumed" / "history.csv"));
+  CHECK(test::read_file(dir / "resumed" / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
+  CHECK(test::read_file(dir / "resumed" / "final.sol") == test::read_file(dir / "full" / "final.sol"));
+  std::stringstream resumed_history(test::read_file(dir / "resumed" / "history.csv"));
   rows = -1;
   while (std::getline(resumed_history, line)) ++rows;
   CHECK(rows == 5);

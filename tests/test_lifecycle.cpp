@@ -66,16 +66,9 @@ double metric(const IterationRecord& r, const std::string& name) {
   return 0;
 }
 
-std::string read_file(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 /// history.csv without its wall-clock columns (ms_*), which no two runs share.
 std::string history_without_timings(const std::filesystem::path& file) {
-  std::stringstream in(read_file(file)), out;
+  std::stringstream in(test::read_file(file)), out;
   std::vector<bool> keep;
   for (std::string line; std::getline(in, line);) {
     std::stringstream cells(line);
@@ -91,7 +84,7 @@ std::string history_without_timings(const std::filesystem::path& file) {
 
 /// A format-3 checkpoint rewritten as format 2 (before model states): what older runs left.
 void downgrade_checkpoint(const std::filesystem::path& file) {
-  std::string v3 = read_file(file);
+  std::string v3 = test::read_file(file);
   REQUIRE(v3.rfind("BFCKPT03", 0) == 0);
   std::uint64_t nv, ne, nf;
   std::memcpy(&nv, v3.data() + 32, 8), std::memcpy(&ne, v3.data() + 40, 8), std::memcpy(&nf, v3.data() + 48, 8);
@@ -151,7 +144,7 @@ TEST_CASE("a model stopping at iteration 5: the run ends there, exit 0, outputs 
     CHECK_MESSAGE(std::filesystem::exists(dir / "out" / f), f);
   CHECK_FALSE(std::filesystem::exists(dir / "out" / "step_00006.vtu"));
   // history.csv: the same columns in every row (row 0 included), 6 rows.
-  std::stringstream history(read_file(dir / "out" / "history.csv"));
+  std::stringstream history(test::read_file(dir / "out" / "history.csv"));
   std::string line;
   std::getline(history, line);
   const auto columns = std::count(line.begin(), line.end(), ',');
@@ -163,7 +156,7 @@ TEST_CASE("a model stopping at iteration 5: the run ends there, exit 0, outputs 
   }
   CHECK(rows == 6);
   // The final state's VTU carries V and the model's fields.
-  const std::string vtu = read_file(dir / "out" / "step_00005.vtu");
+  const std::string vtu = test::read_file(dir / "out" / "step_00005.vtu");
   CHECK(vtu.find("Name=\"velocity\" NumberOfComponents=\"3\"") != std::string::npos);
 }
 
@@ -184,7 +177,7 @@ TEST_CASE("model-driven Δt and model state survive a resume: the same steps as 
   const std::string a = history_without_timings(dir / "full" / "history.csv");
   CHECK(a.find(",0.03125,") != std::string::npos);  // 0.025 · 1.25: the model grew Δt
   CHECK(history_without_timings(dir / "part" / "history.csv") == a);
-  CHECK(read_file(dir / "part" / "final.mesh") == read_file(dir / "full" / "final.mesh"));
+  CHECK(test::read_file(dir / "part" / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
 
   // A checkpoint written before model states (format 2) still loads, with a warning.
   auto again = test::run_bodyfit("run " + (dir / "case.toml").string() + " -o " + (dir / "old").string() + common +
@@ -211,8 +204,8 @@ TEST_CASE("a fire run interrupted by SIGINT or kill -9 and resumed ends byte-ide
     CHECK(load_checkpoint(out / "checkpoint.bin").run.iteration == 7);
     auto rest = test::run_bodyfit(run_case + out.string() + " --resume");
     REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
-    CHECK(read_file(out / "arrival_time.asc") == read_file(dir / "full" / "arrival_time.asc"));
-    CHECK(read_file(out / "final.mesh") == read_file(dir / "full" / "final.mesh"));
+    CHECK(test::read_file(out / "arrival_time.asc") == test::read_file(dir / "full" / "arrival_time.asc"));
+    CHECK(test::read_file(out / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
     CHECK(history_without_timings(out / "history.csv") == history_without_timings(dir / "full" / "history.csv"));
   }
 }

@@ -1,9 +1,12 @@
 #include "test_support.hpp"
 
 #include <array>
-#include <vector>
 #include <atomic>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +23,13 @@ TempDir::TempDir(const std::string& name) {
 TempDir::~TempDir() {
   std::error_code ignored;
   std::filesystem::remove_all(path_, ignored);
+}
+
+std::string read_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
 }
 
 CommandResult run_bodyfit(const std::string& arguments) {

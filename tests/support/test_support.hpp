@@ -34,6 +34,9 @@ struct GridSquare {
 };
 SurfaceMesh grid_square(int n, const GridSquare& options = {});
 
+/// The bytes of a file ("" when it cannot be read).
+std::string read_file(const std::filesystem::path& file);
+
 /// Path of a file in the source tree (e.g. "meshes/cube.mesh").
 std::filesystem::path source_path(const std::string& relative);
 
