@@ -153,3 +153,17 @@ TEST_CASE("command line: MMG's -hmax spellings work as in mmgs, usage errors exi
   CHECK_FALSE(std::filesystem::exists(dir / "x.mesh"));
   CHECK(bodyfit::test::run_bodyfit("remesh --help").exit_code == 0);
 }
+
+TEST_CASE("--threads: the same final mesh, byte for byte, with 1 and 2 worker threads") {
+  bodyfit::test::TempDir dir("threads");
+  const std::string run = "run " + bodyfit::test::source_path("meshes/cases/sphere_cap.toml").string() +
+                          " --set surface.h=0.03 --set remesh.hmax=0.03 --set time.iterations=4 "
+                          "--set output.vtu_every=0 --set output.png_every=0 -o ";
+  auto one = bodyfit::test::run_bodyfit("--threads 1 " + run + (dir / "one").string());
+  REQUIRE_MESSAGE(one.exit_code == 0, one.output);
+  auto two = bodyfit::test::run_bodyfit("--threads 2 " + run + (dir / "two").string());
+  REQUIRE_MESSAGE(two.exit_code == 0, two.output);
+  CHECK(bodyfit::test::read_file(dir / "one" / "final.mesh") == bodyfit::test::read_file(dir / "two" / "final.mesh"));
+  CHECK(bodyfit::test::read_file(dir / "one" / "final.sol") == bodyfit::test::read_file(dir / "two" / "final.sol"));
+  CHECK(bodyfit::test::run_bodyfit("--threads -1 mesh sphere --faces 320 -o " + (dir / "x.mesh").string()).exit_code == 2);
+}

@@ -6,11 +6,13 @@
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <string>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <vector>
 
 namespace bodyfit::cli {
@@ -44,6 +46,9 @@ int main(int argc, char** argv) {
   app.add_flag("-v,--verbose", verbosity, "more log output (-vv for debug traces)");
   bool quiet = false;
   app.add_flag("-q,--quiet", quiet, "only errors");
+  int threads = 0;
+  app.add_option("--threads", threads, "worker threads of the parallel stages (0: all cores); results do not depend on it")
+      ->check(CLI::Range(0, 4096));
 
   auto& commands = cli::registry();
   std::stable_sort(commands.begin(), commands.end(),
@@ -64,6 +69,10 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);  // prints help, version or the error
     return code == 0 ? 0 : 2;      // a usage error is exit code 2, not CLI11's 105-114
   }
+
+  // oneTBB's limit for the whole process, the plugins' parallel loops included.
+  std::optional<tbb::global_control> thread_limit;
+  if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
 
   auto logger = spdlog::stderr_color_mt("bodyfit");
   spdlog::set_default_logger(logger);
