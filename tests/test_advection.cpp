@@ -390,3 +390,45 @@ TEST_CASE("a characteristic that crosses a cluster of tiny faces gets its long s
   MESSAGE("sub-steps per vertex " << double(report.substeps) / double(report.traced));
   CHECK(report.substeps < 100 * report.traced);
 }
+
+TEST_CASE("Advector::advect_band: the whole-mesh advection at the traced vertices, nothing elsewhere") {
+  const SurfaceMesh mesh = make_sphere({.faces = 20 * 22 * 22});
+  const double h = edge_length_stats(mesh).mean;
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) phi[v.idx()] = std::acos(std::clamp(mesh.point(v)[2], -1.0, 1.0)) - M_PI / 3;
+  const VectorField velocity =
+      sample_vector(mesh, [](const Vec3& p) { return e_beta(p) + 0.5 * OpenMesh::cross(Vec3(0, 0, 1), p); });
+  const double T = 3 * h;  // |V| ≤ ~1.2: the feet lie within ~4h of the traced vertices
+  Advector advector(mesh);
+  const ScalarField whole = advector.advect(phi, velocity, T);
+  std::vector<int> traced, known;
+  for (auto v : mesh.vertices()) {
+    if (std::abs(phi[v.idx()]) <= 2 * h) traced.push_back(v.idx());
+    if (std::abs(phi[v.idx()]) <= 8 * h) known.push_back(v.idx());
+  }
+  // V is garbage outside `known`: the band call must not read it there.
+  VectorField partial = velocity;
+  for (auto v : mesh.vertices())
+    if (std::abs(phi[v.idx()]) > 8 * h) partial[v.idx()] = Vec3(1e3, -1e3, 1e3);
+  ScalarField out(mesh.n_vertices(), 7.0);
+  AdvectionReport report;
+  advector.advect_band(phi, partial, T, traced, known, out, {}, &report);
+  CHECK(report.traced == traced.size());
+  CHECK(report.outside_band == 0);
+  CHECK(report.lost == 0);
+  double worst = 0;
+  std::size_t untouched = 0;
+  for (auto v : mesh.vertices()) {
+    const int i = v.idx();
+    if (std::binary_search(traced.begin(), traced.end(), i)) worst = std::max(worst, std::abs(out[i] - whole[i]));
+    else untouched += out[i] == 7.0;
+  }
+  CHECK(worst <= 1e-12);
+  CHECK(untouched == mesh.n_vertices() - traced.size());
+  // A band too narrow for the reach: the traces that leave it stop at its edge and are counted.
+  std::vector<int> thin;
+  for (auto v : mesh.vertices())
+    if (std::abs(phi[v.idx()]) <= 2.5 * h) thin.push_back(v.idx());
+  advector.advect_band(phi, partial, 10 * T, traced, thin, out, {}, &report);
+  CHECK(report.outside_band > 0);
+}

@@ -491,3 +491,39 @@ TEST_CASE("CLI: bodyfit distance writes the library's values") {
   result = test::run_bodyfit("distance " + (dir / "s.mesh").string() + " -o " + (dir / "x.sol").string());
   CHECK(result.exit_code == 1);
 }
+
+TEST_CASE("DistanceSolver::redistance: the whole-mesh signed distance within the band, nothing beyond") {
+  const SurfaceMesh mesh = make_sphere({.faces = 9680});
+  const double h = edge_length_stats(mesh).mean;
+  // Not a distance: a wavy, scaled level set whose zero set is a wobbly curve round the sphere.
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    phi[v.idx()] = 3 * (p[2] - 0.2 + 0.1 * std::sin(5 * std::atan2(p[1], p[0])));
+  }
+  const ScalarField exact = signed_distance(mesh, phi);
+  const double width = 6 * h;
+  // `near`: a superset of the vertices of the faces where φ changes sign.
+  std::vector<int> near;
+  for (auto v : mesh.vertices())
+    if (std::abs(exact[v.idx()]) <= 2 * h) near.push_back(v.idx());
+  DistanceSolver solver(mesh);
+  for (int round = 0; round < 2; ++round) {  // the second call reuses the solver's arrays
+    ScalarField band_phi = phi;
+    const std::vector<int> band = solver.redistance(band_phi, width, near);
+    std::vector<int> expected;
+    for (auto v : mesh.vertices())
+      if (std::abs(exact[v.idx()]) <= width) expected.push_back(v.idx());
+    CHECK(band == expected);
+    double worst = 0;
+    std::size_t untouched = 0;
+    for (auto v : mesh.vertices()) {
+      const int i = v.idx();
+      if (std::binary_search(band.begin(), band.end(), i)) worst = std::max(worst, std::abs(band_phi[i] - exact[i]));
+      else untouched += band_phi[i] == phi[i];
+    }
+    CHECK(worst <= 1e-12);
+    CHECK(untouched == mesh.n_vertices() - band.size());
+    CHECK(band.size() < mesh.n_vertices() / 2);  // a band, not the mesh
+  }
+}

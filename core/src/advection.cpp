@@ -30,6 +30,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -65,6 +67,9 @@ static_assert(sizeof(Face) == 64);
 struct alignas(64) FaceMotion {
   double rate[3][2];  ///< rate[j] = first two increments per unit time of V at corner j
   float edge2[3];     ///< (ℓ_k / mean edge length)², ℓ_k the edge opposite corner k (only sizes steps)
+  /// The advect call that filled `rate`: a band call fills only the faces around the vertices where
+  /// V is known, and a walk reaching another face is counted as having left the band.
+  std::uint32_t epoch;
 };
 static_assert(sizeof(FaceMotion) == 64);
 
@@ -85,9 +90,12 @@ struct Surface {
   std::vector<int> vertex_face;          ///< one face incident to each vertex
   std::vector<signed char> vertex_slot;  ///< the vertex's corner slot in that face
   std::vector<int> vertex_order;         ///< vertices in Z-order: neighbours trace through the same faces
+  std::vector<int> vertex_rank;          ///< position of each vertex in vertex_order
+  std::vector<int> fan_start, fan;       ///< vertex → its faces (CSR, slots), built on first band call
 };
 
-Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
+/// The walk's geometry (everything but the velocity), in Z-order.
+Surface build_surface(const SurfaceMesh& mesh) {
   Surface s;
   const int nf = int(mesh.n_faces());
   const int nv = int(mesh.n_vertices());
@@ -110,7 +118,8 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
   // Vertices in Z-order, faces in the order of their first corner in it (a counting sort): a walk's
   // next face is then usually close in memory, and so are the faces of neighbouring vertices.
   s.vertex_order = z_order(s.points);
-  std::vector<int> rank(nv);
+  std::vector<int>& rank = s.vertex_rank;
+  rank.resize(nv);
   for (int k = 0; k < nv; ++k) rank[s.vertex_order[k]] = k;
   std::vector<int> start(std::size_t(nv) + 1, 0);
   for (int fi = 0; fi < nf; ++fi)
@@ -133,8 +142,7 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
       const std::array<int, 3>& corner = s.corners[slot] = corners[fi];
       const Vec3 p[3] = {s.points[corner[0]], s.points[corner[1]], s.points[corner[2]]};
       const auto grad = p1_basis_gradients(p[0], p[1], p[2]);
-      for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 2; ++i) m.rate[j][i] = OpenMesh::dot(grad[i], velocity[corner[j]]);
+      m.epoch = 0;
       double mean = 0;
       for (int k = 0; k < 3; ++k) mean += (p[(k + 2) % 3] - p[(k + 1) % 3]).norm() / 3.0;
       for (int k = 0; k < 3; ++k)
@@ -187,6 +195,29 @@ Surface build_surface(const SurfaceMesh& mesh, const VectorField& velocity) {
       }
     }
   return s;
+}
+
+/// V on the face in `slot` as coordinate increments per unit time at its corners.
+void fill_motion(Surface& s, int slot, const VectorField& velocity, std::uint32_t epoch) {
+  FaceMotion& m = s.motion[slot];
+  const std::array<int, 3>& corner = s.corners[slot];
+  const auto grad = p1_basis_gradients(s.points[corner[0]], s.points[corner[1]], s.points[corner[2]]);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 2; ++i) m.rate[j][i] = OpenMesh::dot(grad[i], velocity[corner[j]]);
+  m.epoch = epoch;
+}
+
+/// The faces around each vertex (for the faces of a band).
+void build_fans(Surface& s) {
+  const std::size_t nv = s.points.size();
+  s.fan_start.assign(nv + 1, 0);
+  for (const auto& c : s.corners)
+    for (int v : c) ++s.fan_start[v + 1];
+  for (std::size_t v = 0; v < nv; ++v) s.fan_start[v + 1] += s.fan_start[v];
+  s.fan.resize(s.fan_start[nv]);
+  std::vector<int> fill(s.fan_start.begin(), s.fan_start.end() - 1);
+  for (int slot = 0; slot < int(s.corners.size()); ++slot)
+    for (int v : s.corners[slot]) s.fan[fill[v]++] = slot;
 }
 
 // ---- the walker --------------------------------------------------------------------------------
@@ -322,12 +353,15 @@ struct TraceResult {
   std::size_t substeps = 0;
   bool boundary = false;
   bool stalled = false;
+  bool outside = false;  ///< reached a face where V is not known (a band call)
 };
 
-/// Trace the characteristic through `start` backwards over a time T.
-TraceResult trace(const Surface& s, Location start, double T, const AdvectionOptions& opt,
+/// Trace the characteristic through `start` backwards over a time T, reading V on the faces whose
+/// motion was filled by the call `epoch`.
+TraceResult trace(const Surface& s, Location start, double T, const AdvectionOptions& opt, std::uint32_t epoch,
                   std::vector<Crossed>& path) {
   TraceResult r;
+  auto known = [&](int face) { return s.motion[face].epoch == epoch; };
   Location x = start;
   const int outer = std::max(1, opt.steps);
   const double outer_dt = T / outer;
@@ -337,6 +371,10 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
     Location y = from;
     path.clear();
     if (walk(s, y, d, &path) == WalkEnd::stalled) return false;
+    if (!known(y.face)) {
+      r.outside = true;
+      return false;
+    }
     k = velocity_at(s, y);
     for (auto c = path.rbegin(); c != path.rend(); ++c) k = carry(s.faces[c->face], c->far_slot, k);
     return true;
@@ -349,6 +387,10 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
     // must not keep their tiny sub-steps for the rest of its time.
     double dt = 0;
     while (remaining > 0) {
+      if (!known(x.face)) {
+        r.outside = true;
+        break;
+      }
       const Delta k1 = velocity_at(s, x);
       const double speed2 = cells2(s, x.face, k1);  // in cells per unit time, squared
       const double reach2 = speed2 * dt * dt;
@@ -363,7 +405,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
       if (opt.rk_order == 4) {
         Delta k2, k3, k4;
         if (!stage(x, (-0.5 * dt) * k1, k2) || !stage(x, (-0.5 * dt) * k2, k3) || !stage(x, (-dt) * k3, k4)) {
-          r.stalled = true;
+          r.stalled = !r.outside;
           break;
         }
         const WalkEnd end = walk(s, x, (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4), nullptr);
@@ -383,8 +425,9 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
         }
       }
     }
-    if (r.boundary || r.stalled) break;
+    if (r.boundary || r.stalled || r.outside) break;
   }
+  if (!known(x.face)) r.outside = true;
   r.foot = x;
   return r;
 }
@@ -403,24 +446,18 @@ void check_inputs(const SurfaceMesh& mesh, std::size_t phi_size, std::size_t oth
   if (options.steps < 1) throw InputError("advect: steps must be at least 1");
 }
 
-}  // namespace
-
-ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,
-                   const AdvectionOptions& options, AdvectionReport* report) {
-  check_inputs(mesh, phi.size(), velocity.size(), T, options, "the velocity");
-  const Surface s = build_surface(mesh, velocity);
-
-  const int nv = int(mesh.n_vertices());
-  ScalarField out(nv, 0.0);
-  VectorField gradients;
-  if (options.gradient_correction) gradients = vertex_gradients(mesh, phi);
+/// Trace the vertices of `order` and write φ(T) at them into out (φ at the foot, P1 or corrected
+/// with the vertex `gradients` of φ).
+void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField* gradients, std::span<const int> order,
+                    double T, const AdvectionOptions& options, std::uint32_t epoch, ScalarField& out,
+                    AdvectionReport* report) {
   const std::vector<Vec3>& points = s.points;
-  std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0};
-  tbb::parallel_for(tbb::blocked_range<int>(0, nv, 256), [&](const tbb::blocked_range<int>& range) {
-    std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0;
+  std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0, local_outside = 0;
     std::vector<Crossed> path;  // scratch for RK4 stages
-    for (int k = range.begin(); k != range.end(); ++k) {
-      const int v = s.vertex_order[k];
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      const int v = order[k];
       const int fi = s.vertex_face[v];
       if (fi < 0) {  // isolated vertex: nothing carries it
         out[v] = phi[v];
@@ -430,14 +467,14 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
       start.face = fi;
       start.b[0] = start.b[1] = start.b[2] = 0.0;
       start.b[s.vertex_slot[v]] = 1.0;
-      const TraceResult r = trace(s, start, T, options, path);
+      const TraceResult r = trace(s, start, T, options, epoch, path);
       const std::array<int, 3>& c = s.corners[r.foot.face];
       double value = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
-      if (options.gradient_correction) {
+      if (gradients && !r.outside) {
         const Vec3 x = r.foot.b[0] * points[c[0]] + r.foot.b[1] * points[c[1]] + r.foot.b[2] * points[c[2]];
         double taylor = 0, lo = phi[c[0]], hi = phi[c[0]];
         for (int j = 0; j < 3; ++j) {
-          taylor += r.foot.b[j] * (phi[c[j]] + OpenMesh::dot(gradients[c[j]], x - points[c[j]]));
+          taylor += r.foot.b[j] * (phi[c[j]] + OpenMesh::dot((*gradients)[c[j]], x - points[c[j]]));
           lo = std::min(lo, phi[c[j]]);
           hi = std::max(hi, phi[c[j]]);
         }
@@ -448,19 +485,96 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
       local_sub += r.substeps;
       local_boundary += r.boundary;
       local_lost += r.stalled;
+      local_outside += r.outside;
     }
     substeps += local_sub;
     boundary += local_boundary;
     lost += local_lost;
     traced += local_traced;
+    outside += local_outside;
   });
   if (report) {
     report->traced = traced;
     report->substeps = substeps;
     report->hit_boundary = boundary;
     report->lost = lost;
+    report->outside_band = outside;
   }
+}
+
+}  // namespace
+
+struct Advector::Impl {
+  explicit Impl(const SurfaceMesh& m) : mesh(m), surface(build_surface(m)) {}
+  const SurfaceMesh& mesh;
+  Surface surface;
+  std::uint32_t epoch = 0;
+  VectorField gradients;                  ///< of φ, where the current call needs them
+  std::vector<std::uint32_t> vertex_seen;  ///< band calls: = epoch for the vertices where V is known
+  std::vector<int> faces, order;          ///< band calls: faces with V known at 3 corners; traced in Z-order
+};
+
+Advector::Advector(const SurfaceMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {}
+Advector::~Advector() = default;
+Advector::Advector(Advector&&) noexcept = default;
+
+ScalarField Advector::advect(const ScalarField& phi, const VectorField& velocity, double T,
+                             const AdvectionOptions& options, AdvectionReport* report) {
+  Impl& a = *impl_;
+  check_inputs(a.mesh, phi.size(), velocity.size(), T, options, "the velocity");
+  Surface& s = a.surface;
+  const std::uint32_t epoch = ++a.epoch;
+  tbb::parallel_for(tbb::blocked_range<int>(0, int(s.faces.size()), 4096), [&](const tbb::blocked_range<int>& range) {
+    for (int slot = range.begin(); slot != range.end(); ++slot) fill_motion(s, slot, velocity, epoch);
+  });
+  if (options.gradient_correction) a.gradients = vertex_gradients(a.mesh, phi);
+  ScalarField out(phi.size(), 0.0);
+  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, s.vertex_order, T, options, epoch, out,
+                 report);
   return out;
+}
+
+void Advector::advect_band(const ScalarField& phi, const VectorField& velocity, double T, std::span<const int> traced,
+                           std::span<const int> known, ScalarField& out, const AdvectionOptions& options,
+                           AdvectionReport* report) {
+  Impl& a = *impl_;
+  check_inputs(a.mesh, phi.size(), velocity.size(), T, options, "the velocity");
+  if (out.size() != phi.size()) throw InputError("advect_band: the output has one value per vertex");
+  Surface& s = a.surface;
+  const std::size_t nv = s.points.size();
+  const std::uint32_t epoch = ++a.epoch;
+  if (s.fan_start.empty()) build_fans(s);
+  a.vertex_seen.resize(nv, 0);
+  for (int v : known) a.vertex_seen[v] = epoch;
+  // The faces whose three corners have V: each once, found from its lowest known corner.
+  a.faces.clear();
+  for (int v : known)
+    for (int j = s.fan_start[v]; j < s.fan_start[v + 1]; ++j) {
+      const std::array<int, 3>& c = s.corners[s.fan[j]];
+      if (a.vertex_seen[c[0]] == epoch && a.vertex_seen[c[1]] == epoch && a.vertex_seen[c[2]] == epoch &&
+          v == std::min({c[0], c[1], c[2]}))
+        a.faces.push_back(s.fan[j]);
+    }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.faces.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) fill_motion(s, a.faces[k], velocity, epoch);
+  });
+  if (options.gradient_correction) {
+    a.gradients.resize(nv);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, known.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t k = range.begin(); k != range.end(); ++k)
+        a.gradients[known[k]] = vertex_gradient(a.mesh, VertexHandle(known[k]), phi);
+    });
+  }
+  // Z-order for the traces, as in a full call.
+  a.order.assign(traced.begin(), traced.end());
+  std::sort(a.order.begin(), a.order.end(), [&](int u, int w) { return s.vertex_rank[u] < s.vertex_rank[w]; });
+  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, out, report);
+}
+
+ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,
+                   const AdvectionOptions& options, AdvectionReport* report) {
+  check_inputs(mesh, phi.size(), velocity.size(), T, options, "the velocity");
+  return Advector(mesh).advect(phi, velocity, T, options, report);
 }
 
 ScalarField advect_normal(const SurfaceMesh& mesh, const ScalarField& phi, const ScalarField& normal_speed,

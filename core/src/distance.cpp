@@ -4,6 +4,8 @@
 #include <bodyfit/distance.hpp>
 #include <bodyfit/error.hpp>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -335,36 +337,44 @@ double curvature_seen_from(const Vec3& p, const Vec3& a, const Vec3& b, const Ve
 /// by the interface, the interface segments inside it.
 struct Seeds {
   std::vector<signed char> sign;
+  std::vector<int> zeros;                       // the vertices on the zero set (sign 0)
   std::vector<int> faces;                       // seed faces
   std::vector<int> seg_start;                   // per seed face, into segments (CSR)
   std::vector<std::pair<Vec3, Vec3>> segments;  // a point is a segment with equal ends
   std::vector<std::pair<Vec3, Vec3>> bends;     // empty, or per segment the curvature vectors at its ends
 };
 
+/// The zero set of φ in face f, appended to s as one seed face when φ vanishes there.
+void add_phi_seed(const FlatMesh& m, const ScalarField& phi, int f, Seeds& s) {
+  auto sign = [&](int v) { return phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0; };
+  std::array<Vec3, 3> zero;
+  int count = 0;
+  for (int c = 0; c < 3; ++c) {
+    const int a = m.corner_vertex[3 * f + c], b = m.corner_vertex[3 * f + (c + 1) % 3];
+    if (sign(a) == 0) zero[count++] = m.points[a];
+    if (sign(a) * sign(b) < 0) {
+      const double t = phi[a] / (phi[a] - phi[b]);  // scale-free
+      zero[count++] = m.points[a] + (m.points[b] - m.points[a]) * t;
+    }
+  }
+  if (count == 0) return;
+  s.faces.push_back(f);
+  if (count == 1) s.segments.emplace_back(zero[0], zero[0]);
+  else if (count == 2) s.segments.emplace_back(zero[0], zero[1]);
+  else
+    for (int i = 0; i < 3; ++i) s.segments.emplace_back(zero[i], zero[(i + 1) % 3]);
+  s.seg_start.push_back(int(s.segments.size()));
+}
+
 Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
   Seeds s;
   s.sign.resize(m.nv);
-  for (std::size_t v = 0; v < m.nv; ++v) s.sign[v] = phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0;
-  s.seg_start.push_back(0);
-  for (std::size_t f = 0; f < m.nf; ++f) {
-    std::array<Vec3, 3> zero;
-    int count = 0;
-    for (int c = 0; c < 3; ++c) {
-      const int a = m.corner_vertex[3 * f + c], b = m.corner_vertex[3 * f + (c + 1) % 3];
-      if (s.sign[a] == 0) zero[count++] = m.points[a];
-      if (s.sign[a] * s.sign[b] < 0) {
-        const double t = phi[a] / (phi[a] - phi[b]);  // scale-free
-        zero[count++] = m.points[a] + (m.points[b] - m.points[a]) * t;
-      }
-    }
-    if (count == 0) continue;
-    s.faces.push_back(int(f));
-    if (count == 1) s.segments.emplace_back(zero[0], zero[0]);
-    else if (count == 2) s.segments.emplace_back(zero[0], zero[1]);
-    else
-      for (int i = 0; i < 3; ++i) s.segments.emplace_back(zero[i], zero[(i + 1) % 3]);
-    s.seg_start.push_back(int(s.segments.size()));
+  for (std::size_t v = 0; v < m.nv; ++v) {
+    s.sign[v] = phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0;
+    if (s.sign[v] == 0) s.zeros.push_back(int(v));
   }
+  s.seg_start.push_back(0);
+  for (std::size_t f = 0; f < m.nf; ++f) add_phi_seed(m, phi, int(f), s);
   return s;
 }
 
@@ -437,7 +447,10 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved)
     on_interface[mesh.to_vertex_handle(h).idx()] = 1;
   }
   for (std::size_t v = 0; v < m.nv; ++v)
-    if (on_interface[v]) s.sign[v] = 0;
+    if (on_interface[v]) {
+      s.sign[v] = 0;
+      s.zeros.push_back(int(v));
+    }
   s.seg_start.push_back(0);
   for (std::size_t f = 0; f < m.nf; ++f) {
     const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
@@ -488,17 +501,51 @@ std::vector<double> gaussian_curvature(const FlatMesh& m) {
   return gauss;
 }
 
-ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options,
-                  DistanceReport& report) {
+/// The march's per-vertex arrays, kept between the calls of a DistanceSolver so that a narrow-band
+/// call touches only the band: `touched` lists the vertices whose entries differ from the initial
+/// (dist ∞, κ 0, state 0), and `reset` restores only those.
+struct MarchWorkspace {
+  std::vector<double> dist, kappa;
+  std::vector<std::uint8_t> state;  ///< 0 far, 1 tentative, 2 fixed by the initialisation, 3 accepted
+  std::vector<int> stamp;           ///< ring marks: stamp_base + seed face index
+  int stamp_base = 0;
+  std::vector<int> touched;
+
+  void prepare(std::size_t nv, std::size_t seed_faces) {
+    if (dist.size() != nv) {
+      dist.assign(nv, kInf);
+      kappa.assign(nv, 0.0);
+      state.assign(nv, 0);
+      stamp.assign(nv, -1);
+      stamp_base = 0;
+      touched.clear();
+    }
+    for (int v : touched) dist[v] = kInf, kappa[v] = 0, state[v] = 0;
+    touched.clear();
+    if (stamp_base > std::numeric_limits<int>::max() - int(seed_faces) - 1) {
+      std::fill(stamp.begin(), stamp.end(), -1);
+      stamp_base = 0;
+    }
+  }
+  void set(int v, double d) {
+    if (dist[v] == kInf && state[v] == 0) touched.push_back(v);
+    dist[v] = d;
+  }
+};
+
+/// Exact initialisation next to the seeds, then fast marching up to options.narrow_band. The result
+/// is in w.dist / w.state (accepted = 3) for the vertices of w.touched.
+void march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options, MarchWorkspace& w,
+           DistanceReport& report) {
   const std::size_t nv = m.nv;
-  std::vector<double> dist(nv, kInf);
+  w.prepare(nv, seeds.faces.size());
+  std::vector<double>& dist = w.dist;
   // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's when
   // it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
   const bool track = options.front_curvature && !seeds.bends.empty();
-  std::vector<double> kappa(nv, 0.0);
+  std::vector<double>& kappa = w.kappa;
   const std::vector<double> gauss = track ? gaussian_curvature(m) : std::vector<double>();
-  // 0 far, 1 tentative, 2 fixed by the initialisation (final, not yet expanded), 3 accepted
-  std::vector<std::uint8_t> state(nv, 0);
+  std::vector<std::uint8_t>& state = w.state;
   report.has_interface = !seeds.faces.empty();
 
   // Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
@@ -507,31 +554,35 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
   // The vertices up to kNearRings rings further get the same direct distance: final where it is
   // below kNearRadius shortest edges (every interface point that close lies in a seed face within
   // those rings), tentative beyond. This keeps the near field second-order accurate.
-  std::vector<int> stamp(nv, -1);
+  std::vector<int>& stamp = w.stamp;
+  const int base = w.stamp_base;
+  w.stamp_base += int(seeds.faces.size());
   std::vector<int> ring;
   for (std::size_t i = 0; i < seeds.faces.size(); ++i) {
     const int f = seeds.faces[i];
+    const int mark = base + int(i);
     ring.clear();
     for (int c = 0; c < 3; ++c) {
       const int u = m.corner_vertex[3 * f + c];
-      stamp[u] = int(i);
+      stamp[u] = mark;
       ring.push_back(u);
+      if (state[u] == 0 && dist[u] == kInf) w.touched.push_back(u);
       state[u] = 2;
     }
     for (int depth = 0, begin = 0; depth < kNearRings; ++depth) {
       const int end = int(ring.size());
       for (int r = begin; r < end; ++r)
         for (int j = m.fan_start[ring[r]]; j < m.fan_start[ring[r] + 1]; ++j)
-          for (int w : {m.fan[j].a, m.fan[j].b})
-            if (stamp[w] != int(i)) {
-              stamp[w] = int(i);
-              ring.push_back(w);
+          for (int x : {m.fan[j].a, m.fan[j].b})
+            if (stamp[x] != mark) {
+              stamp[x] = mark;
+              ring.push_back(x);
             }
       begin = end;
     }
-    for (int w : ring) {
-      const Vec3& p = m.points[w];
-      double best = dist[w];
+    for (int x : ring) {
+      const Vec3& p = m.points[x];
+      double best = dist[x];
       int best_segment = -1;
       for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k) {
         const auto& [a, b] = seeds.segments[k];
@@ -546,17 +597,21 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
         }
       }
       if (best_segment < 0) continue;  // an earlier seed face was closer
-      dist[w] = best;
+      w.set(x, best);
       if (track) {
         const auto& [a, b] = seeds.segments[best_segment];
         const auto& [ka, kb] = seeds.bends[best_segment];
-        kappa[w] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss[w]);
+        kappa[x] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss[x]);
       }
     }
   }
   MinHeap heap;
-  for (std::size_t v = 0; v < nv; ++v) {
-    if (seeds.sign[v] == 0) dist[v] = 0;
+  // The initial heap: every vertex given a value so far (in touched), in index order so that the
+  // march does not depend on the order the seeds came in.
+  for (int v : seeds.zeros) w.set(v, 0.0);
+  std::vector<int> initial = w.touched;
+  std::sort(initial.begin(), initial.end());
+  for (int v : initial) {
     if (dist[v] == kInf) continue;
     if (state[v] == 0) {
       double shortest = kInf;
@@ -565,9 +620,8 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
       state[v] = dist[v] * dist[v] <= kNearRadius * kNearRadius * shortest ? 2 : 1;
     }
     if (state[v] == 2) ++report.initialised;
-    heap.emplace(dist[v], int(v));
+    heap.emplace(dist[v], v);
   }
-
   auto known = [&](int v) { return state[v] >= 2; };
   // Update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
   auto update = [&](const CornerGeometry& g, int a, int b, int x) {
@@ -619,7 +673,7 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
           value = {d + length, track ? carried_curvature(kappa[v], length, gauss[x]) : 0.0};
         }
         if (value.d < dist[x]) {
-          dist[x] = value.d;
+          w.set(x, value.d);
           kappa[x] = value.kappa;
           state[x] = 1;
           heap.emplace(value.d, x);
@@ -633,16 +687,20 @@ ScalarField march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& 
       if (known(x)) continue;
       const FrontValue value = split_update(split);
       if (value.d < dist[x]) {
-        dist[x] = value.d;
+        w.set(x, value.d);
         kappa[x] = value.kappa;
         state[x] = 1;
         heap.emplace(value.d, x);
       }
     }
   }
-  ScalarField result(nv);
-  for (std::size_t v = 0; v < nv; ++v) {
-    const double value = state[v] == 3 && dist[v] <= options.narrow_band ? dist[v] : kInf;
+}
+
+/// The signed result of a whole-mesh march: ±d where accepted within the band, ±∞ elsewhere.
+ScalarField signed_result(const Seeds& seeds, const MarchWorkspace& w, double band) {
+  ScalarField result(w.dist.size());
+  for (std::size_t v = 0; v < result.size(); ++v) {
+    const double value = w.state[v] == 3 && w.dist[v] <= band ? w.dist[v] : kInf;
     result[v] = seeds.sign[v] > 0 ? value : seeds.sign[v] < 0 ? -value : 0.0;
   }
   return result;
@@ -652,41 +710,115 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-template <class MakeSeeds>
-ScalarField run(const SurfaceMesh& mesh, const DistanceOptions& options, DistanceReport* report,
-                MakeSeeds make_seeds) {
-  DistanceReport local;
-  auto start = std::chrono::steady_clock::now();
-  FlatMesh m = flatten(mesh);
-  find_obtuse_corners(m);
-  build_fans(m);
-  local.setup_ms = milliseconds_since(start);
-  start = std::chrono::steady_clock::now();
-  const Seeds seeds = make_seeds(m);
-  local.init_ms = milliseconds_since(start);
-  start = std::chrono::steady_clock::now();
-  ScalarField d = march(m, seeds, options, local);
-  local.march_ms = milliseconds_since(start);
-  if (report) *report = local;
-  return d;
-}
-
-}  // namespace
-
-ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi, const DistanceOptions& options,
-                            DistanceReport* report) {
+void check_level_set(const SurfaceMesh& mesh, const ScalarField& phi) {
   if (phi.size() != mesh.n_vertices())
     throw InputError("signed_distance: the level set has " + std::to_string(phi.size()) + " values for " +
                      std::to_string(mesh.n_vertices()) + " vertices");
   for (double value : phi)
     if (!std::isfinite(value)) throw InputError("signed_distance: the level set has a non-finite value");
-  return run(mesh, options, report, [&](const FlatMesh& m) { return seeds_from_phi(m, phi); });
+}
+
+FlatMesh prepared_mesh(const SurfaceMesh& mesh) {
+  FlatMesh m = flatten(mesh);
+  find_obtuse_corners(m);
+  build_fans(m);
+  return m;
+}
+
+}  // namespace
+
+struct DistanceSolver::Impl {
+  explicit Impl(const SurfaceMesh& m) : mesh(m), flat(prepared_mesh(m)) {}
+  const SurfaceMesh& mesh;
+  FlatMesh flat;
+  double setup_ms = 0;
+  MarchWorkspace workspace;
+  std::vector<std::uint32_t> face_seen;  ///< redistance: = epoch for the faces searched in this call
+  std::uint32_t epoch = 0;
+
+  template <class MakeSeeds>
+  ScalarField run(const DistanceOptions& options, DistanceReport* report, MakeSeeds make_seeds) {
+    DistanceReport local;
+    local.setup_ms = std::exchange(setup_ms, 0.0);  // charged to the first call only
+    auto start = std::chrono::steady_clock::now();
+    const Seeds seeds = make_seeds(flat);
+    local.init_ms = milliseconds_since(start);
+    start = std::chrono::steady_clock::now();
+    march(flat, seeds, options, workspace, local);
+    ScalarField d = signed_result(seeds, workspace, options.narrow_band);
+    local.march_ms = milliseconds_since(start);
+    if (report) *report = local;
+    return d;
+  }
+};
+
+DistanceSolver::DistanceSolver(const SurfaceMesh& mesh) {
+  const auto start = std::chrono::steady_clock::now();
+  impl_ = std::make_unique<Impl>(mesh);
+  impl_->setup_ms = milliseconds_since(start);
+}
+DistanceSolver::~DistanceSolver() = default;
+DistanceSolver::DistanceSolver(DistanceSolver&&) noexcept = default;
+
+ScalarField DistanceSolver::signed_distance(const ScalarField& phi, const DistanceOptions& options,
+                                            DistanceReport* report) {
+  check_level_set(impl_->mesh, phi);
+  return impl_->run(options, report, [&](const FlatMesh& m) { return seeds_from_phi(m, phi); });
+}
+
+ScalarField DistanceSolver::signed_distance_to_region(const DistanceOptions& options, DistanceReport* report) {
+  return impl_->run(options, report, [&](const FlatMesh& m) {
+    return seeds_from_region(impl_->mesh, m, options.curved_interface);
+  });
+}
+
+std::vector<int> DistanceSolver::redistance(ScalarField& phi, double width, std::span<const int> near,
+                                            DistanceReport* report) {
+  Impl& s = *impl_;
+  const FlatMesh& m = s.flat;
+  if (phi.size() != m.nv) check_level_set(s.mesh, phi);
+  if (!(width > 0)) throw InputError("redistance: the band width must be positive");
+  DistanceReport local;
+  auto start = std::chrono::steady_clock::now();
+  // The zero set, in the faces around `near`: each face once.
+  const std::uint32_t epoch = ++s.epoch;
+  s.face_seen.resize(m.nf, 0);
+  Seeds seeds;
+  seeds.seg_start.push_back(0);
+  for (int v : near) {
+    if (!std::isfinite(phi[v])) throw InputError(fmt::format("redistance: non-finite level set at vertex {}", v));
+    if (phi[v] == 0) seeds.zeros.push_back(v);
+    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j) {
+      const int f = m.fan[j].corner / 3;
+      if (s.face_seen[f] == epoch) continue;
+      s.face_seen[f] = epoch;
+      add_phi_seed(m, phi, f, seeds);
+    }
+  }
+  local.init_ms = milliseconds_since(start);
+  start = std::chrono::steady_clock::now();
+  DistanceOptions options;
+  options.narrow_band = width;
+  march(m, seeds, options, s.workspace, local);
+  std::vector<int> band;
+  for (int v : s.workspace.touched)
+    if (s.workspace.state[v] == 3 && s.workspace.dist[v] <= width) band.push_back(v);
+  std::sort(band.begin(), band.end());
+  for (int v : band) phi[v] = phi[v] > 0 ? s.workspace.dist[v] : phi[v] < 0 ? -s.workspace.dist[v] : 0.0;
+  local.march_ms = milliseconds_since(start);
+  if (report) *report = local;
+  return band;
+}
+
+ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi, const DistanceOptions& options,
+                            DistanceReport* report) {
+  check_level_set(mesh, phi);  // before the set-up
+  return DistanceSolver(mesh).signed_distance(phi, options, report);
 }
 
 ScalarField signed_distance_to_region(const SurfaceMesh& mesh, const DistanceOptions& options,
                                       DistanceReport* report) {
-  return run(mesh, options, report,
-             [&](const FlatMesh& m) { return seeds_from_region(mesh, m, options.curved_interface); });
+  return DistanceSolver(mesh).signed_distance_to_region(options, report);
 }
 
 }  // namespace bodyfit

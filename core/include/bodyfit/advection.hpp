@@ -4,6 +4,9 @@
 // backwards along V on the triangulated surface.
 #include <bodyfit/mesh.hpp>
 
+#include <memory>
+#include <span>
+
 namespace bodyfit {
 
 struct AdvectionOptions {
@@ -24,12 +27,40 @@ struct AdvectionReport {
   std::size_t hit_boundary = 0;      ///< stopped on the boundary of an open surface
   std::size_t substeps = 0;          ///< total sub-steps over all vertices
   std::size_t lost = 0;              ///< characteristics that failed (must stay 0)
+  /// Band calls: reached a face where V is not known and stopped there (a characteristic running
+  /// away from the front, whose sign the stop does not change).
+  std::size_t outside_band = 0;
 };
 
 /// Solve ∂φ/∂t + V·∇_S φ = 0 on (0, T), V given at the vertices (projected on the tangent plane
 /// where evaluated). Returns φ(T) at the vertices. Deterministic for any thread count.
 ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,
                    const AdvectionOptions& options = {}, AdvectionReport* report = nullptr);
+
+/// Advections on one fixed mesh: its flat walking arrays are built once, so repeated calls (the
+/// CFL sub-steps of a step) pay only for V and the traces; a band call traces only some vertices,
+/// so its cost follows the band, not the mesh. The mesh must outlive the Advector, unchanged.
+class Advector {
+ public:
+  explicit Advector(const SurfaceMesh& mesh);
+  ~Advector();
+  Advector(Advector&&) noexcept;
+
+  /// As advect(): φ(T) at every vertex.
+  ScalarField advect(const ScalarField& phi, const VectorField& velocity, double T, const AdvectionOptions& options = {},
+                     AdvectionReport* report = nullptr);
+  /// Narrow band: φ(T) at the vertices `traced` only, written into `out` (its other values are left
+  /// as they are). V (and φ's gradient) is read only on the faces whose three corners are in
+  /// `known`, which should hold the faces the characteristics cross (`traced` plus the reach
+  /// T·max|V| and a face); a trace leaving it stops at its edge (report->outside_band).
+  void advect_band(const ScalarField& phi, const VectorField& velocity, double T, std::span<const int> traced,
+                   std::span<const int> known, ScalarField& out, const AdvectionOptions& options = {},
+                   AdvectionReport* report = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// The Hamilton–Jacobi form (3.3): V = v ∇_S φ/|∇_S φ| (per-face gradients of φ averaged to the
 /// vertices, area-weighted), then advect().

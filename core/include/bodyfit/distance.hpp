@@ -3,6 +3,9 @@
 #include <bodyfit/mesh.hpp>
 
 #include <limits>
+#include <memory>
+#include <span>
+#include <vector>
 
 namespace bodyfit {
 
@@ -42,5 +45,31 @@ ScalarField signed_distance(const SurfaceMesh& mesh, const ScalarField& phi,
 /// interface is the set of e:interface edges; inside vertices get negative values.
 ScalarField signed_distance_to_region(const SurfaceMesh& mesh, const DistanceOptions& options = {},
                                       DistanceReport* report = nullptr);
+
+/// Distances on one fixed mesh, its flat arrays and obtuse-angle unfoldings built once: the d of a
+/// state and then the redistancing of each CFL sub-step, whose narrow-band calls cost what the
+/// band holds, not the mesh. The mesh must outlive the solver, unchanged.
+class DistanceSolver {
+ public:
+  explicit DistanceSolver(const SurfaceMesh& mesh);
+  ~DistanceSolver();
+  DistanceSolver(DistanceSolver&&) noexcept;
+
+  /// As the free functions of the same names.
+  ScalarField signed_distance(const ScalarField& phi, const DistanceOptions& options = {},
+                              DistanceReport* report = nullptr);
+  ScalarField signed_distance_to_region(const DistanceOptions& options = {}, DistanceReport* report = nullptr);
+
+  /// Narrow-band redistancing in place: φ becomes its signed distance (φ-mode, as signed_distance)
+  /// at the vertices within `width` of its zero set, which are returned (sorted); every other
+  /// value is left as it is. The zero set is looked for in the faces around the vertices `near`,
+  /// which must include every vertex of a face where φ changes sign.
+  std::vector<int> redistance(ScalarField& phi, double width, std::span<const int> near,
+                              DistanceReport* report = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace bodyfit
