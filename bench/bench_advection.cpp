@@ -3,6 +3,8 @@
 // where β > T. Errors in the band |β − π/2| < 0.25.
 //   bench_advection [out.csv] [--rk 4] [--cells C] [--p1] [--repeat N] [--sizes 11,22,44]
 // (sizes are the sphere frequencies k, 20k² faces; times are medians over N calls, default 5)
+#include "bench_args.hpp"
+
 #include <bodyfit/advection.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
@@ -12,9 +14,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,23 +25,22 @@ int main(int argc, char** argv) {
   AdvectionOptions options;
   std::vector<int> ks = {11, 22, 44, 88, 176};
   int repeat = 5;  // timings are the median of this many calls (a shared machine is noisy)
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--rk") && i + 1 < argc) {
-      options.rk_order = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--cells") && i + 1 < argc) {
-      options.max_cells_per_substep = std::atof(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--p1")) {
-      options.gradient_correction = false;
-    } else if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) {
-      repeat = std::max(1, std::atoi(argv[++i]));
-    } else if (!std::strcmp(argv[i], "--sizes") && i + 1 < argc) {
-      ks.clear();
-      std::stringstream list(argv[++i]);
-      for (std::string item; std::getline(list, item, ',');) ks.push_back(std::stoi(item));
-    } else {
-      csv = argv[i];
-    }
-  }
+  bench::Arguments args("bench_advection",
+                        "usage: bench_advection [out.csv] [--rk 4] [--cells C] [--p1] [--repeat N] [--sizes 11,22,44]\n"
+                        "  out.csv   CSV output (default bench_advection.csv)\n"
+                        "  --rk      Runge-Kutta order of the characteristics (2 or 4)\n"
+                        "  --cells   cells crossed per sub-step (max_cells_per_substep)\n"
+                        "  --p1      plain P1 values at the feet (no gradient correction)\n"
+                        "  --repeat  calls per size; times are their median (default 5)\n"
+                        "  --sizes   sphere frequencies k (20k^2 faces; default 11,22,44,88,176)\n");
+  args.positional("out.csv", csv);
+  args.option("--rk", options.rk_order);
+  args.option("--cells", options.max_cells_per_substep);
+  args.flag("--p1", [&] { options.gradient_correction = false; });
+  args.option("--repeat", repeat);
+  args.option("--sizes", ks);
+  args.parse(argc, argv);
+  repeat = std::max(1, repeat);
   const double a = M_PI / 4, T = M_PI / 4;
   std::ofstream out(csv);
   out << "faces,h,band_l2,band_linf,order,ms,cpu_ms,setup_ms,substeps,lost\n";

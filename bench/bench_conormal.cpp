@@ -7,6 +7,8 @@
 //
 // Writes outdir/conormal.csv (one row per run, with per-stage times) and outdir/conormal.png
 // (E against h, log-log, one line per c, with the paper's values for comparison).
+#include "bench_args.hpp"
+
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
@@ -20,11 +22,9 @@
 #include <chrono>
 #include <functional>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <map>
 #include <numbers>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,13 +34,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kCapAngle = kPi / 4;
-
-std::vector<double> parse_list(const char* text) {
-  std::vector<double> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) out.push_back(std::stod(item));
-  return out;
-}
 
 /// E of (4.5) with the edge-midpoint rule on each flat triangle.
 double cap_error(const SurfaceMesh& mesh, const ScalarField& d, double final_angle) {
@@ -109,20 +102,17 @@ int main(int argc, char** argv) {
   std::vector<double> cs{0.1, 0.25, 0.5, 0.75, 1.0};
   std::string outdir = "bench_conormal_out";
   double max_seconds = 1e30;  // skip the remaining (finer) runs of a c once one run took longer
-  for (int i = 1; i < argc; ++i) {
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) throw std::runtime_error(fmt::format("{} needs a value", argv[i]));
-      return argv[++i];
-    };
-    if (!std::strcmp(argv[i], "--h")) hs = parse_list(next());
-    else if (!std::strcmp(argv[i], "--c")) cs = parse_list(next());
-    else if (!std::strcmp(argv[i], "-o")) outdir = next();
-    else if (!std::strcmp(argv[i], "--max-seconds")) max_seconds = std::stod(next());
-    else {
-      fmt::print(stderr, "usage: bench_conormal [--h 0.2,0.1,...] [--c 0.1,0.25,...] [-o outdir] [--max-seconds S]\n");
-      return 2;
-    }
-  }
+  bench::Arguments args("bench_conormal",
+                        "usage: bench_conormal [--h 0.2,0.1,...] [--c 0.1,0.25,...] [-o outdir] [--max-seconds S]\n"
+                        "  --h            mesh sizes h (hmax = h; default 0.2,0.1,0.05,0.025)\n"
+                        "  --c            CFL numbers c (dt = c h; default 0.1,0.25,0.5,0.75,1)\n"
+                        "  -o             output directory: conormal.csv, conormal.png (default bench_conormal_out)\n"
+                        "  --max-seconds  skip the finer runs of a c once one run took longer than S\n");
+  args.option("--h", hs);
+  args.option("--c", cs);
+  args.option("-o", outdir);
+  args.option("--max-seconds", max_seconds);
+  args.parse(argc, argv);
   std::filesystem::create_directories(outdir);
   spdlog::set_level(spdlog::level::warn);
   std::sort(hs.begin(), hs.end(), std::greater<>());

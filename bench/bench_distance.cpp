@@ -7,6 +7,8 @@
 // thread CPU time, and the wall time of each stage); writes the table as CSV.
 //
 //   bench_distance [out.csv] [repetitions]
+#include "bench_args.hpp"
+
 #include <bodyfit/distance.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
@@ -85,8 +87,16 @@ Row measure(std::size_t k, int repetitions) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string csv = argc > 1 ? argv[1] : "distance.csv";
-  const int repetitions = argc > 2 ? std::max(1, std::atoi(argv[2])) : 5;
+  std::string csv = "distance.csv";
+  int repetitions = 5;
+  bench::Arguments args("bench_distance",
+                        "usage: bench_distance [out.csv] [repetitions]\n"
+                        "  out.csv      CSV output (default distance.csv)\n"
+                        "  repetitions  runs per sphere; times are the best (default 5)\n");
+  args.positional("out.csv", csv);
+  args.positional("repetitions", repetitions);
+  args.parse(argc, argv);
+  repetitions = std::max(1, repetitions);
   std::vector<Row> rows;
   std::printf("%9s %9s %10s %10s %6s %12s %6s %10s %9s %9s %8s %8s %7s %7s %7s\n", "faces", "vertices", "h", "L2", "ord",
               "Linf|d|<2h", "ord", "Linf", "init", "marched", "ms", "cpu_ms", "setup", "segs", "march");

@@ -12,6 +12,8 @@
 //   bench_fire --plot outdir run_dir [run_dir...]
 //     Reads each run's history.csv (from `bodyfit run`) and writes outdir/fire_area.png and
 //     outdir/fire_perimeter.png: burnt area (km²) and front length (km) against time (min).
+#include "bench_args.hpp"
+
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/plot.hpp>
@@ -22,7 +24,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -108,27 +109,30 @@ int main(int argc, char** argv) {
   int iterations = 6;
   double max_cfl = -1;  // < 0: the case's [time] max_cfl
   std::filesystem::path outdir = "bench_fire_out";
-  if (argc >= 3 && !std::strcmp(argv[1], "--plot")) {
-    std::vector<std::filesystem::path> runs(argv + 3, argv + argc);
-    return plot_runs(argv[2], runs);
+  std::filesystem::path plot_dir;
+  std::vector<std::filesystem::path> runs;
+  bench::Arguments args("bench_fire",
+                        "usage: bench_fire [--case file.toml] [--h 200] [--iterations 6] [--max-cfl k] [-o outdir]\n"
+                        "       bench_fire --plot outdir run_dir [run_dir...]\n"
+                        "  --case        fire case (default meshes/cases/fire_one_disk.toml)\n"
+                        "  --h           terrain edge length and hmax in metres (default 200)\n"
+                        "  --iterations  iterations to time (default 6)\n"
+                        "  --max-cfl     sub-step cap (0: one pass per step; default: the case's)\n"
+                        "  -o            output directory: fire_timing.csv (default bench_fire_out)\n"
+                        "  --plot        plot the burnt area and front length of finished `bodyfit run` outputs\n");
+  args.option("--case", case_file);
+  args.option("--h", h);
+  args.option("--iterations", iterations);
+  args.option("-o", outdir);
+  args.option("--max-cfl", max_cfl);
+  args.option("--plot", plot_dir);
+  args.positionals("run_dir", runs);
+  args.parse(argc, argv);
+  if (!plot_dir.empty()) {
+    if (runs.empty()) args.fail("--plot needs at least one run directory");
+    return plot_runs(plot_dir, runs);
   }
-  for (int i = 1; i < argc; ++i) {
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) throw std::runtime_error(fmt::format("{} needs a value", argv[i]));
-      return argv[++i];
-    };
-    if (!std::strcmp(argv[i], "--case")) case_file = next();
-    else if (!std::strcmp(argv[i], "--h")) h = std::stod(next());
-    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::stoi(next());
-    else if (!std::strcmp(argv[i], "-o")) outdir = next();
-    else if (!std::strcmp(argv[i], "--max-cfl")) max_cfl = std::stod(next());
-    else {
-      fmt::print(stderr,
-                 "usage: bench_fire [--case file.toml] [--h 200] [--iterations 6] [--max-cfl k] [-o outdir]\n"
-                 "       bench_fire --plot outdir run_dir [run_dir...]\n");
-      return 2;
-    }
-  }
+  if (!runs.empty()) args.fail("run directories are read only with --plot");
   std::filesystem::create_directories(outdir);
   spdlog::set_level(spdlog::level::warn);
 

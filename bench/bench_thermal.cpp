@@ -8,6 +8,8 @@
 // state; review = tetrahedralisation, assembly, factorisation and solves of the candidate) and of the
 // model's own split (history.csv's ms_tetgen, ms_assembly, ms_factor, ms_solve, ms_regularise) are
 // printed and written as CSV, with the tetrahedra and surface triangles.
+#include "bench_args.hpp"
+
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/plugin_loader.hpp>
@@ -17,10 +19,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 using namespace bodyfit;
 
@@ -32,13 +32,6 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-std::vector<double> parse_list(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, ',');) out.push_back(std::stod(item));
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -46,27 +39,20 @@ int main(int argc, char** argv) try {
   std::vector<double> hs = {0.05, 0.035, 0.025};
   int iterations = 8;
   std::string solver = "conjugate_gradient";
-  const char* usage =
-      "usage: bench_thermal [--case file.toml] [--h 0.05,0.035,0.025] [--iterations 8] [--solver name] "
-      "[-o thermal_timing.csv]\n";
-  for (int i = 1; i < argc; ++i) {
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(fmt::format("{} needs a value", argv[i]));
-      return argv[++i];
-    };
-    if (!std::strcmp(argv[i], "--case")) case_file = next();
-    else if (!std::strcmp(argv[i], "--h")) hs = parse_list(next());
-    else if (!std::strcmp(argv[i], "--iterations")) iterations = std::stoi(next());
-    else if (!std::strcmp(argv[i], "--solver")) solver = next();
-    else if (!std::strcmp(argv[i], "-o")) csv_file = next();
-    else if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-      fmt::print("{}", usage);
-      return 0;
-    } else {
-      fmt::print(stderr, "unknown argument '{}'\n{}", argv[i], usage);
-      return 2;
-    }
-  }
+  bench::Arguments args("bench_thermal",
+                        "usage: bench_thermal [--case file.toml] [--h 0.05,0.035,0.025] [--iterations 8] [--solver name] "
+                        "[-o thermal_timing.csv]\n"
+                        "  --case        thermal case (default meshes/cases/thermal_bracket_fine.toml)\n"
+                        "  --h           hmax values, one row each (epsilon = 2h)\n"
+                        "  --iterations  iterations per size; times are their median (default 8)\n"
+                        "  --solver      the model's linear solver (default conjugate_gradient)\n"
+                        "  -o            CSV output (default thermal_timing.csv)\n");
+  args.option("--case", case_file);
+  args.option("--h", hs);
+  args.option("--iterations", iterations);
+  args.option("--solver", solver);
+  args.option("-o", csv_file);
+  args.parse(argc, argv);
   spdlog::set_level(spdlog::level::warn);
   const std::vector<std::string> model_columns = {"ms_tetgen", "ms_assembly", "ms_factor", "ms_solve", "ms_regularise"};
   std::ofstream csv(csv_file);

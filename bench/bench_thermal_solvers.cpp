@@ -14,6 +14,8 @@
 #include "thermal_fem.hpp"
 #include "volume_mesh.hpp"
 
+#include "bench_args.hpp"
+
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
@@ -24,7 +26,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <sstream>
@@ -87,40 +88,19 @@ int main(int argc, char** argv) {
   int repeat = 3;
   double eps_ratio = 2;
   std::string csv_path = "bench_thermal_solvers.csv";
-  try {
-    for (int i = 1; i < argc; ++i) {
-      auto next = [&]() -> std::string {
-        if (i + 1 >= argc) throw InputError(fmt::format("{} needs a value", argv[i]));
-        return argv[++i];
-      };
-      std::string a = argv[i];
-      if (a == "--help" || a == "-h") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else if (a == "--faces") {
-        sizes.clear();
-        for (const auto& item : split(next())) sizes.push_back(std::stoul(item));
-      } else if (a == "--solvers") {
-        std::string list = next();
-        solvers.clear();
-        if (list == "all") solvers = all;
-        else
-          for (const auto& item : split(list)) solvers.push_back(linear_solver_from_string(item));
-      } else if (a == "--repeat") {
-        repeat = std::stoi(next());
-      } else if (a == "--eps") {
-        eps_ratio = std::stod(next());
-      } else if (a == "-o") {
-        csv_path = next();
-      } else {
-        throw InputError(fmt::format("unknown argument '{}'", a));
-      }
-    }
-    if (sizes.empty() || solvers.empty() || repeat < 0 || !(eps_ratio > 0)) throw InputError("nothing to measure");
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "bench_thermal_solvers: {}\n{}", e.what(), kUsage);
-    return 2;
-  }
+  bench::Arguments args("bench_thermal_solvers", kUsage);
+  args.option("--faces", sizes);
+  args.option("--solvers", [&](const std::string& list) {
+    solvers.clear();
+    if (list == "all") solvers = all;
+    else
+      for (const auto& item : split(list)) solvers.push_back(linear_solver_from_string(item));
+  });
+  args.option("--repeat", repeat);
+  args.option("--eps", eps_ratio);
+  args.option("-o", csv_path);
+  args.parse(argc, argv);
+  if (sizes.empty() || solvers.empty() || repeat < 0 || !(eps_ratio > 0)) args.fail("nothing to measure");
 
   std::ofstream csv(csv_path);
   csv << "surface_faces,h,tets,vertices,min_dihedral_deg,tetgen_ms,setup_ms,robin_ms,solver,analysis_ms,"

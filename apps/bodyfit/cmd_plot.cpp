@@ -1,5 +1,6 @@
 // bodyfit plot history.csv -y J -o J.png: line plots of run histories (any CSV with a header row),
-// one series per (file, column); several files compare runs.
+// one series per (file, column); several files compare runs. --log-x / --log-y for log axes (e.g.
+// time against mesh size), --label names the files' series, --legend moves the legend to a corner.
 #include "commands.hpp"
 
 #include <bodyfit/error.hpp>
@@ -10,6 +11,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -20,7 +22,7 @@ using namespace bodyfit;
 
 struct PlotArguments {
   std::vector<std::string> files, columns, labels;
-  std::string x = "iteration", output, title, size = "800x600";
+  std::string x = "iteration", output, title, y_label, size = "800x600", legend = "top-right";
   bool log_x = false, log_y = false;
 };
 
@@ -49,6 +51,15 @@ std::vector<std::pair<std::string, std::vector<double>>> read_columns(const fs::
       throw file_error(file, number, fmt::format("{} cells, the header has {} columns", c, columns.size()));
   }
   return columns;
+}
+
+const std::map<std::string, LegendPosition>& legend_corners() {
+  static const std::map<std::string, LegendPosition> corners{{"top-right", LegendPosition::top_right},
+                                                             {"top-left", LegendPosition::top_left},
+                                                             {"bottom-right", LegendPosition::bottom_right},
+                                                             {"bottom-left", LegendPosition::bottom_left},
+                                                             {"none", LegendPosition::none}};
+  return corners;
 }
 
 const std::vector<double>& column(const std::vector<std::pair<std::string, std::vector<double>>>& columns,
@@ -87,8 +98,9 @@ int plot_command(const PlotArguments& args) {
   options.width = w, options.height = h;
   options.title = args.title;
   options.x_label = args.x;
-  options.y_label = args.columns.size() == 1 ? args.columns.front() : "";
+  options.y_label = !args.y_label.empty() ? args.y_label : args.columns.size() == 1 ? args.columns.front() : "";
   options.log_x = args.log_x, options.log_y = args.log_y;
+  options.legend = legend_corners().at(args.legend);
   plot_png(args.output, series, options);
   spdlog::info("{} series -> {}", series.size(), args.output);
   return 0;
@@ -103,6 +115,10 @@ bodyfit::cli::Command setup_plot(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "output .png")->required();
   cmd->add_option("--label", args->labels, "legend label per file (default: the file's directory)");
   cmd->add_option("--title", args->title, "plot title");
+  cmd->add_option("--y-label", args->y_label, "label of the vertical axis (default: the column, if only one)");
+  cmd->add_option("--legend", args->legend, "corner of the legend")
+      ->check(CLI::IsMember(legend_corners()))
+      ->capture_default_str();
   cmd->add_option("--size", args->size, "image size WxH")->capture_default_str();
   cmd->add_flag("--log-x", args->log_x, "logarithmic x axis");
   cmd->add_flag("--log-y", args->log_y, "logarithmic y axis");

@@ -142,12 +142,16 @@ Image plot(const std::vector<PlotSeries>& series, const PlotOptions& options) {
           image.fill_rect(int(px(s.x[i])) - 3, int(py(s.y[i])) - 3, int(px(s.x[i])) + 4, int(py(s.y[i])) + 4, s.color);
   }
 
-  // Legend in the top-right corner of the plot area.
+  // Legend in a corner of the plot area (top right by default).
   int rows = 0, widest = 0;
   for (const auto& s : series)
     if (!s.label.empty()) ++rows, widest = std::max(widest, Image::text_width(s.label));
-  if (rows > 0) {
-    int x1 = right - 8, x0 = x1 - widest - 44, y0 = top + 8, y1 = y0 + rows * 14 + 8;
+  if (rows > 0 && options.legend != LegendPosition::none) {
+    const bool at_left = options.legend == LegendPosition::top_left || options.legend == LegendPosition::bottom_left;
+    const bool at_bottom = options.legend == LegendPosition::bottom_left || options.legend == LegendPosition::bottom_right;
+    const int width = widest + 44, height = rows * 14 + 8;
+    int x0 = at_left ? left + 8 : right - 8 - width, x1 = x0 + width;
+    int y0 = at_bottom ? bottom - 8 - height : top + 8, y1 = y0 + height;
     image.fill_rect(x0, y0, x1, y1, {255, 255, 255});
     image.line(x0, y0, x1, y0, ink), image.line(x0, y1, x1, y1, ink);
     image.line(x0, y0, x0, y1, ink), image.line(x1, y0, x1, y1, ink);

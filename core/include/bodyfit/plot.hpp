@@ -17,10 +17,14 @@ struct PlotSeries {
   bool dashed = false;
 };
 
+/// Corner of the plot area that holds the legend (none: no legend).
+enum class LegendPosition { top_right, top_left, bottom_right, bottom_left, none };
+
 struct PlotOptions {
   int width = 800, height = 600;
   std::string title, x_label, y_label;
   bool log_x = false, log_y = false;
+  LegendPosition legend = LegendPosition::top_right;
 };
 
 /// A qualitative palette (10 distinct colours) for series i.
