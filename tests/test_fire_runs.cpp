@@ -44,7 +44,7 @@ struct FireRun {
 // Burn disks (x, y, r in plan view) for `steps` steps of `dt` with the fire model configured by `toml_text`.
 FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disks, const std::string& toml_text,
              double dt, int steps, const std::filesystem::path& output_dir = {}, double hausd = 0,
-             double max_cfl = 0) {
+             double max_cfl = 0, bool narrow_band = true) {
   ScalarField phi(surface.n_vertices());
   for (auto v : surface.vertices()) {
     double best = std::numeric_limits<double>::infinity();
@@ -66,6 +66,7 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   options.terrain = true;
   options.output_dir = output_dir;
   options.max_cfl = max_cfl;
+  options.narrow_band = narrow_band;
   options.cfl_length = remesh.hmax;
   FireRun run;
   run.result = evolve(surface, model.model(), options, {}, EvolutionHooks::quiet());
@@ -153,6 +154,43 @@ TEST_CASE("CFL-capped sub-steps (max_cfl): the head still runs uphill at R(alpha
   INFO("head " << head << " exact " << head_exact << "; back " << back << " exact " << back_exact);
   CHECK(head == doctest::Approx(head_exact).epsilon(0.02));
   CHECK(back == doctest::Approx(back_exact).epsilon(0.03));
+}
+
+TEST_CASE("narrow-band sub-steps: the whole-surface computation's front and arrival times") {
+  // Bumpy ground and a wind: R varies along the front and the sub-steps recompute it near the front.
+  const double h = 20, size = 1400;
+  HeightGrid grid;
+  grid.cell_size = h;
+  grid.cols = grid.rows = std::size_t(size / h) + 1;
+  grid.heights.resize(grid.cols * grid.rows);
+  for (std::size_t r = 0; r < grid.rows; ++r)
+    for (std::size_t c = 0; c < grid.cols; ++c)
+      grid.heights[r * grid.cols + c] = 60 * std::sin(double(c) * h / 170) * std::cos(double(r) * h / 230);
+  const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
+  test::TempDir dir_band("fire_band"), dir_whole("fire_whole");
+  FireRun band = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 120, 3, dir_band.path(), 0.05, 1.0);
+  FireRun whole =
+      burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 120, 3, dir_whole.path(), 0.05, 1.0, false);
+  REQUIRE(band.result.records.size() == 3);
+  REQUIRE(whole.result.records.size() == 3);
+  for (std::size_t k = 0; k < 3; ++k) {
+    CHECK(band.result.records[k].substeps == whole.result.records[k].substeps);
+    CHECK(band.result.records[k].substeps >= 3);
+  }
+  const double area = region_area(whole.mesh, kInside);
+  CHECK(std::abs(region_area(band.mesh, kInside) - area) <= 1e-9 * area);
+  CHECK(interface_hausdorff(band.mesh, whole.mesh) <= 1e-6 * h);
+  // The arrival raster: the band visits only the cells near the front, with the same result.
+  const HeightGrid a = read_raw_grid(dir_band.path() / "arrival_time.asc");
+  const HeightGrid b = read_raw_grid(dir_whole.path() / "arrival_time.asc");
+  REQUIRE(a.heights.size() == b.heights.size());
+  std::size_t reached = 0, differ = 0;
+  for (std::size_t i = 0; i < a.heights.size(); ++i) {
+    reached += a.heights[i] != a.nodata;
+    differ += std::abs(a.heights[i] - b.heights[i]) > 1e-6;
+  }
+  CHECK(reached > 100);
+  CHECK(differ == 0);
 }
 
 TEST_CASE("uniform wind on flat ground: the head moves at R(atan(|U|/u0))") {

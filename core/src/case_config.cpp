@@ -172,6 +172,7 @@ void parse_time(const toml::table& table, TimeSpec& out) {
   out.dt = p.number("dt", 0, kPositive);
   out.cfl = p.number("cfl", 0, kPositive);
   out.max_cfl = p.number("max_cfl", 0, kPositive);
+  out.narrow_band = p.boolean("narrow_band", out.narrow_band);
   out.final_time = p.number("final_time", out.final_time, kPositive);
   out.iterations = long(p.integer("iterations", -1, 0));
   out.max_rejections = clamp_to_int(p.integer("max_rejections", out.max_rejections, 0));

@@ -108,6 +108,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * setup.h;
   options.final_time = config.time.final_time;
   options.max_cfl = config.time.max_cfl;
+  options.narrow_band = config.time.narrow_band;
   options.max_rejections = config.time.max_rejections;
   options.cfl_length = setup.h;
   options.max_iterations = config.time.iterations;

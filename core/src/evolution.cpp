@@ -12,6 +12,9 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <span>
+#include <stdexcept>
+#include <vector>
 
 namespace bodyfit {
 namespace {
@@ -36,34 +39,50 @@ std::size_t count_inside(const SurfaceMesh& mesh) {
 }
 
 /// d of a state: the signed distance to G, or ∓∞ everywhere when G is the whole surface or empty.
-ScalarField distance_of(const SurfaceMesh& mesh, const DistanceOptions& options) {
+ScalarField distance_of(const SurfaceMesh& mesh, DistanceSolver& solver, const DistanceOptions& options) {
   const std::size_t inside = count_inside(mesh);
-  if (inside > 0 && inside < mesh.n_faces()) return signed_distance_to_region(mesh, options);
+  if (inside > 0 && inside < mesh.n_faces()) return solver.signed_distance_to_region(options);
   return ScalarField(mesh.n_vertices(), inside ? -INFINITY : INFINITY);
 }
 
 /// The model's field as the vector field V the advection takes (V = v·n_Σ for a normal speed),
-/// checked: one finite vector per vertex.
-VectorField velocity_of(VelocityField& field, const StepContext& context, std::string_view model) {
+/// written at the vertices `where` (all when empty) and checked there: finite vectors.
+void velocity_into(const VelocityField& field, const StepContext& context, std::string_view model,
+                   std::span<const int> where, VectorField& velocity) {
   const std::size_t n = context.mesh().n_vertices();
-  VectorField velocity;
-  if (field.kind == VelocityField::Kind::Tangential) {
-    velocity = field.vector;
-  } else {
-    if (field.normal_speed.size() != n)
-      throw InputError(fmt::format("model '{}': {} normal speeds for {} vertices", model, field.normal_speed.size(), n));
-    const VectorField& conormal = context.conormal();
-    velocity.resize(n);
-    for (std::size_t i = 0; i < n; ++i) velocity[i] = field.normal_speed[i] * conormal[i];
-  }
-  if (velocity.size() != n)
-    throw InputError(fmt::format("model '{}': {} velocities for {} vertices", model, velocity.size(), n));
-  // A NaN would pass through the advection and the cut silently and give a wrong region.
-  for (std::size_t i = 0; i < n; ++i)
-    if (!std::isfinite(velocity[i][0]) || !std::isfinite(velocity[i][1]) || !std::isfinite(velocity[i][2]))
+  const bool tangential = field.kind == VelocityField::Kind::Tangential;
+  const std::size_t given = tangential ? field.vector.size() : field.normal_speed.size();
+  if (given != n)
+    throw InputError(fmt::format("model '{}': {} {} for {} vertices", model, given,
+                                 tangential ? "velocities" : "normal speeds", n));
+  const VectorField* conormal = tangential ? nullptr : &context.conormal();
+  velocity.resize(n);
+  auto set = [&](std::size_t i) {
+    const Vec3 v = tangential ? field.vector[i] : field.normal_speed[i] * (*conormal)[i];
+    // A NaN would pass through the advection and the cut silently and give a wrong region.
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
       throw InputError(fmt::format("model '{}', iteration {}: non-finite velocity at vertex {} ({}, {}, {})", model,
-                                   context.iteration(), i, velocity[i][0], velocity[i][1], velocity[i][2]));
+                                   context.iteration(), i, v[0], v[1], v[2]));
+    velocity[i] = v;
+  };
+  if (where.empty())
+    for (std::size_t i = 0; i < n; ++i) set(i);
+  else
+    for (int i : where) set(std::size_t(i));
+}
+
+VectorField velocity_of(const VelocityField& field, const StepContext& context, std::string_view model) {
+  VectorField velocity;
+  velocity_into(field, context, model, {}, velocity);
   return velocity;
+}
+
+/// The vertices where |φ| ≤ width (sorted).
+std::vector<int> within(const ScalarField& phi, double width) {
+  std::vector<int> band;
+  for (std::size_t i = 0; i < phi.size(); ++i)
+    if (std::abs(phi[i]) <= width) band.push_back(int(i));
+  return band;
 }
 
 /// What step 2 (d, V, advection, sub-steps) hands to the cut.
@@ -82,7 +101,7 @@ class Evolution {
         n_(start.iteration), t_(start.time), dt_(start.dt > 0 ? start.dt : options.dt) {}
 
   EvolutionResult run() {
-    distance_ = distance_of(mesh_, options_.distance);
+    measure_distance();
     while (!should_stop()) advance();
     return finish();
   }
@@ -127,6 +146,7 @@ class Evolution {
                                      model_.name()));
       mesh_ = *kept_mesh;  // restore T^n exactly
       distance_ = kept_distance;
+      solver_.reset();  // built on the candidate
       if (hooks_.log)
         spdlog::info("n={} step of dt={:.5g} rejected by model '{}': {}{}", n_ + 1, dt, model_.name(), review.reason,
                      review.stop ? std::string("; the model stops the run")
@@ -148,71 +168,158 @@ class Evolution {
 
   // ---- 2. d and V, advection (CFL sub-steps on T^n) -------------------------------------------
   LevelSetStep level_set_step(double dt, int attempt) {
+    if (options_.max_cfl > 0 && !needs_.freeze_velocity) return front_step(dt, attempt);
+    // One advection over the step (or, for a frozen V, CFL sub-steps transporting φ with it).
     LevelSetStep step;
-    ScalarField redistanced;  // d of the moved front, for the sub-steps after the first
-    VectorField velocity;
+    Stopwatch clock;
+    VectorField velocity = first_velocity(step, dt, attempt, clock);
+    Advector advector(mesh_);
+    ScalarField phi = distance_;
     while (step.done < dt) {
       const double remaining = dt - step.done;
-      const bool first = step.substeps == 0;
-      Stopwatch clock;
-      // φ at the start of this sub-step: d^n, then the advected φ — redistanced, unless V is frozen
-      // (then φ is only transported and needs no distance property).
-      if (!first && !needs_.freeze_velocity) redistanced = signed_distance(mesh_, step.phi_next, options_.distance);
-      const ScalarField& phi = first ? distance_ : needs_.freeze_velocity ? step.phi_next : redistanced;
-      step.ms.distance += clock.lap_ms();
-      if (first && attempt > 0) {
-        velocity = state_velocity_;  // T^n and d^n are those of the first attempt: so is V^n
-      } else if (first || !needs_.freeze_velocity) {
-        const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining);
-        VelocityField field = model_.compute(context);
-        velocity = velocity_of(field, context, model_.name());
-        if (first) {
-          state_field_ = std::move(field);
-          state_velocity_ = velocity;
-        }
-      }
-      const double sub = substep_length(velocity, remaining);
-      step.ms.velocity += clock.lap_ms();
-      if (first && attempt == 0 && hooks_.on_state) {  // outputs show the state T^n with d^n and V^n
-        hooks_.on_state(StateView{mesh_, n_, t_, distance_, &state_velocity_, &state_field_, false});
-        step.ms.output += clock.lap_ms();
-      }
-      AdvectionReport report;
-      ScalarField next = advect(mesh_, phi, velocity, sub, options_.advection, &report);
-      model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt});
-      step.phi_next = std::move(next);
+      const double sub = substep_length(velocity, {}, remaining);
+      ScalarField next = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
       step.ms.advect += clock.lap_ms();
-      if (report.lost > 0) spdlog::warn("iteration {}: {} characteristics lost in advection", n_, report.lost);
-      ++step.substeps;
-      step.done = sub == remaining ? dt : step.done + sub;
-      // G vanished or fills S within the step: no front left to measure a distance to.
-      const auto [lowest, highest] = std::minmax_element(step.phi_next.begin(), step.phi_next.end());
+      phi = std::move(next);
+      // G vanished or fills S within the step: nothing left to move.
+      const auto [lowest, highest] = std::minmax_element(phi.begin(), phi.end());
       if (step.done < dt && (*lowest >= 0 || *highest < 0)) break;
     }
+    step.phi_next = std::move(phi);
     return step;
   }
 
-  /// Equal sub-steps over what remains of the step, each moving no point by more than max_cfl·h.
-  double substep_length(const VectorField& velocity, double remaining) const {
+  /// CFL sub-steps with V recomputed on the moved front: each redistances φ, asks the model for V
+  /// and advects. With options_.narrow_band only near the front (EvolutionOptions::narrow_band),
+  /// else on the whole surface; max|V| is over the band in both.
+  LevelSetStep front_step(double dt, int attempt) {
+    LevelSetStep step;
+    Stopwatch clock;
+    const bool in_band = options_.narrow_band;
+    if (!solver_) solver_.emplace(mesh_);
+    DistanceSolver& solver = *solver_;  // T^n's flat arrays, for every sub-step
+    Advector advector(mesh_);
+    StepGeometry geometry;
+    const double cap = options_.max_cfl * cfl_length();
+    const double longest = edge_length_stats(mesh_).max;
+    const double traced_width = cap + 2 * longest;  // the front cannot reach further within a sub-step
+    const double width = traced_width + cap + 2 * longest;  // where the traces read d and V
+    ScalarField phi = distance_, next;
+    std::vector<int> band = within(phi, width), traced;
+    if (in_band) next = phi;
+    step.ms.distance += clock.lap_ms();
+    VectorField velocity;
+    while (step.done < dt) {
+      const double remaining = dt - step.done;
+      if (step.substeps > 0) {  // φ: the advected one, redistanced around its zero set
+        if (in_band) {
+          std::vector<int> moved = solver.redistance(phi, width, traced);
+          // Leaving the band: |φ| ≥ width with its sign, so that φ stays a distance clamped there.
+          for (int v : band)
+            if (!std::binary_search(moved.begin(), moved.end(), v)) phi[v] = next[v] = std::copysign(width, phi[v]);
+          for (int v : moved) next[v] = phi[v];
+          band = std::move(moved);
+        } else {
+          phi = solver.signed_distance(phi, options_.distance);
+          band = within(phi, width);
+        }
+        step.ms.distance += clock.lap_ms();
+        if (band.empty()) break;  // G vanished or fills S within the step
+      }
+      if (step.substeps == 0) {
+        velocity = first_velocity(step, dt, attempt, clock, &geometry);
+      } else {
+        const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining, in_band ? band : std::span<const int>(), &geometry);
+        const VelocityField field = model_.compute(context);
+        velocity_into(field, context, model_.name(), in_band ? band : std::span<const int>(), velocity);
+        step.ms.velocity += clock.lap_ms();
+      }
+      // The vertices the front can reach within a sub-step: traced, and their speed sizes it (a
+      // characteristic from further away must cross them, which takes longer than the sub-step).
+      traced.clear();
+      for (int v : band)
+        if (std::abs(phi[v]) <= traced_width) traced.push_back(v);
+      const double sub = substep_length(velocity, traced, remaining);
+      if (in_band) {
+        AdvectionReport report;
+        advector.advect_band(phi, velocity, sub, traced, band, next, options_.advection, &report);
+        check_report(report);
+        model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt, traced});
+        for (int v : traced) phi[v] = next[v];
+        advance_substep(step, sub, remaining, dt);
+      } else {
+        phi = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
+      }
+      step.ms.advect += clock.lap_ms();
+    }
+    step.phi_next = std::move(phi);
+    return step;
+  }
+
+  /// V^n on T^n with d^n, over the whole surface (the state's outputs show it); a retried step
+  /// reuses it (T^n and d^n are those of the first attempt).
+  VectorField first_velocity(LevelSetStep& step, double dt, int attempt, Stopwatch& clock,
+                             StepGeometry* geometry = nullptr) {
+    if (attempt == 0) {
+      const StepContext context = context_for(mesh_, distance_, n_, t_, dt, {}, geometry);
+      state_field_ = model_.compute(context);
+      state_velocity_ = velocity_of(state_field_, context, model_.name());
+    }
+    step.ms.velocity += clock.lap_ms();
+    if (attempt == 0 && hooks_.on_state) {  // outputs show the state T^n with d^n and V^n
+      hooks_.on_state(StateView{mesh_, n_, t_, distance_, &state_velocity_, &state_field_, false});
+      step.ms.output += clock.lap_ms();
+    }
+    return state_velocity_;
+  }
+
+  /// One whole-surface advection sub-step: φ at its end.
+  ScalarField advect_substep(Advector& advector, const ScalarField& phi, const VectorField& velocity, double sub,
+                             double remaining, double dt, int attempt, LevelSetStep& step) {
+    AdvectionReport report;
+    ScalarField next = advector.advect(phi, velocity, sub, options_.advection, &report);
+    check_report(report);
+    model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt});
+    advance_substep(step, sub, remaining, dt);
+    return next;
+  }
+
+  void advance_substep(LevelSetStep& step, double sub, double remaining, double dt) const {
+    ++step.substeps;
+    step.done = sub == remaining ? dt : step.done + sub;
+  }
+
+  void check_report(const AdvectionReport& report) const {
+    if (report.lost > 0) spdlog::warn("iteration {}: {} characteristics lost in advection", n_, report.lost);
+  }
+
+  /// Equal sub-steps over what remains of the step, each moving no point of `band` (all when
+  /// empty) by more than max_cfl·h.
+  double substep_length(const VectorField& velocity, std::span<const int> band, double remaining) const {
     if (!(options_.max_cfl > 0)) return remaining;
     double vmax = 0;
-    for (const Vec3& v : velocity) vmax = std::max(vmax, v.norm());
+    if (band.empty())
+      for (const Vec3& v : velocity) vmax = std::max(vmax, v.norm());
+    else
+      for (int i : band) vmax = std::max(vmax, velocity[i].norm());
     if (!std::isfinite(vmax))
       throw InputError(fmt::format("model '{}': non-finite velocity (max_cfl cannot size the sub-steps)", model_.name()));
-    const double reach = options_.max_cfl * (options_.cfl_length > 0 ? options_.cfl_length : mean_edge_length(mesh_));
-    const double ratio = vmax * remaining / reach;
+    const double ratio = vmax * remaining / (options_.max_cfl * cfl_length());
     return ratio > 1 + 1e-9 ? remaining / std::ceil(ratio - 1e-9) : remaining;  // 3.0000000000000004 is 3
   }
 
+  double cfl_length() const { return options_.cfl_length > 0 ? options_.cfl_length : mean_edge_length(mesh_); }
+
   // ---- 3. cut and remesh: the candidate T^{n+1} -------------------------------------------------
   void cut_and_remesh(LevelSetStep& step) {
+    solver_.reset();  // T^n's, and memory the remesh can use
     Stopwatch clock;
     discretize(mesh_, step.phi_next, options_.discretize);
     step.ms.discretize += clock.lap_ms();
     remesh(mesh_, options_.remesh);
     if (options_.canonical_order) canonicalize(mesh_);
     step.ms.remesh += clock.lap_ms();
-    distance_ = distance_of(mesh_, options_.distance);  // d^{n+1}: the review's and the next step's
+    measure_distance();  // d^{n+1}: the review's and the next step's
     step.ms.distance += clock.lap_ms();
   }
 
@@ -267,14 +374,22 @@ class Evolution {
   }
 
   // ---- helpers ---------------------------------------------------------------------------------
-  StepContext context_for(const SurfaceMesh& mesh, const ScalarField& d, int iteration, double time, double dt) const {
+  /// d of the current mesh; its solver is kept for the sub-steps of the next step (same mesh).
+  void measure_distance() {
+    solver_.emplace(mesh_);
+    distance_ = distance_of(mesh_, *solver_, options_.distance);
+  }
+  StepContext context_for(const SurfaceMesh& mesh, const ScalarField& d, int iteration, double time, double dt,
+                          std::span<const int> active = {}, StepGeometry* geometry = nullptr) const {
     return make_step_context(StepState{.mesh = &mesh,
                                        .distance = &d,
                                        .time = time,
                                        .dt = dt,
                                        .iteration = iteration,
                                        .output_dir = options_.output_dir,
-                                       .terrain = options_.terrain});
+                                       .terrain = options_.terrain,
+                                       .active = active,
+                                       .geometry = geometry});
   }
   void stop(StopReason reason, std::string message) {
     stopped_ = true;
@@ -301,6 +416,7 @@ class Evolution {
   double t_;
   double dt_;                   ///< Δt of the next step (the case's, or the model's latest)
   ScalarField distance_;        ///< d of the current state (or of the candidate, in steps 3-5)
+  std::optional<DistanceSolver> solver_;  ///< on the current mesh (distance_'s, then the sub-steps')
   VelocityField state_field_;   ///< the model's answer on T^n (first sub-step of the first attempt)
   VectorField state_velocity_;  ///< V^n
   int rejections_ = 0;          ///< of the current step

@@ -267,6 +267,50 @@ double interface_length(const SurfaceMesh& mesh) {
   return length;
 }
 
+namespace {
+
+double distance_to_segment(const Vec3& p, const Segment& s) {
+  const Vec3 e = s.second - s.first;
+  const double len2 = e.sqrnorm();
+  const double t = len2 > 0 ? std::clamp(OpenMesh::dot(p - s.first, e) / len2, 0.0, 1.0) : 0.0;
+  return (p - (s.first + t * e)).norm();
+}
+
+/// The largest distance from an end or the midpoint of a segment of `from` to the polyline `to`.
+double one_sided(const Segments& from, const Segments& to) {
+  std::vector<double> worst(from.size(), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      for (const Vec3& p : {from[i].first, from[i].second, 0.5 * (from[i].first + from[i].second)}) {
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Segment& s : to) nearest = std::min(nearest, distance_to_segment(p, s));
+        worst[i] = std::max(worst[i], nearest);
+      }
+  });
+  return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
+}
+
+}  // namespace
+
+Segments interface_segments(const SurfaceMesh& mesh) {
+  Segments segments;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e)) {
+      const auto h = mesh.halfedge_handle(e, 0);
+      segments.emplace_back(mesh.point(mesh.from_vertex_handle(h)), mesh.point(mesh.to_vertex_handle(h)));
+    }
+  return segments;
+}
+
+double hausdorff_distance(const Segments& a, const Segments& b) {
+  if (a.empty() != b.empty()) return std::numeric_limits<double>::infinity();
+  return std::max(one_sided(a, b), one_sided(b, a));
+}
+
+double interface_hausdorff(const SurfaceMesh& a, const SurfaceMesh& b) {
+  return hausdorff_distance(interface_segments(a), interface_segments(b));
+}
+
 double l2_difference(const SurfaceMesh& mesh, const ScalarField& u_h, const std::function<double(const Vec3&)>& u) {
   double sum = 0;
   for (auto f : mesh.faces()) {

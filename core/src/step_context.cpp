@@ -26,12 +26,17 @@ struct StepContext::Impl {
   const SurfaceMesh& mesh() const { return *state.mesh; }
 
   const VectorField& vertex_normals_locked() const {
-    if (!vertex_normals) {
-      VectorField normals(mesh().n_vertices(), Vec3(0, 0, 0));
-      for (auto v : mesh().vertices()) normals[v.idx()] = vertex_normal(mesh(), v);
-      vertex_normals = std::move(normals);
-    }
-    return *vertex_normals;
+    auto compute = [&](std::optional<VectorField>& cache) -> const VectorField& {
+      if (!cache) {
+        VectorField normals(mesh().n_vertices(), Vec3(0, 0, 0));
+        for (auto v : mesh().vertices()) normals[v.idx()] = vertex_normal(mesh(), v);
+        cache = std::move(normals);
+      }
+      return *cache;
+    };
+    if (!state.geometry) return compute(vertex_normals);
+    std::lock_guard lock(state.geometry->mutex);  // the step's contexts share one copy
+    return compute(state.geometry->vertex_normals);
   }
   const Eigen::SparseMatrix<double>& mass_locked() const {
     if (!mass) mass = bodyfit::mass_matrix(mesh());
@@ -70,7 +75,9 @@ StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& 
                                      .dt = where.dt,
                                      .iteration = where.iteration,
                                      .output_dir = where.output_dir,
-                                     .terrain = where.terrain});
+                                     .terrain = where.terrain,
+                                     .active = {},
+                                     .geometry = nullptr});
 }
 
 const SurfaceMesh& StepContext::mesh() const { return *impl_->state.mesh; }
@@ -80,6 +87,7 @@ double StepContext::dt() const { return impl_->state.dt; }
 int StepContext::iteration() const { return impl_->state.iteration; }
 const std::filesystem::path& StepContext::output_dir() const { return impl_->state.output_dir; }
 bool StepContext::is_terrain() const { return impl_->state.terrain; }
+std::span<const int> StepContext::active_vertices() const { return impl_->state.active; }
 
 double StepContext::mesh_size() const {
   std::lock_guard lock(impl_->mutex);
@@ -117,10 +125,19 @@ const VectorField& StepContext::conormal() const {
   if (!impl_->conormal) {
     // Area-weighted face gradients of d, projected on the vertex tangent plane, normalised.
     // |∇_S d| = 1 away from the cut locus; where the average cancels (ridges of d) n_Σ is 0.
-    VectorField n = bodyfit::vertex_gradients(mesh(), distance());
-    for (auto& g : n) {
-      double length = g.norm();
-      g = length > 1e-12 ? g / length : Vec3(0, 0, 0);
+    // In a band, only at the active vertices (d is a distance only there).
+    auto unit = [](const Vec3& g) {
+      const double length = g.norm();
+      return length > 1e-12 ? g / length : Vec3(0, 0, 0);
+    };
+    VectorField n;
+    const std::span<const int> active = impl_->state.active;
+    if (active.empty()) {
+      n = bodyfit::vertex_gradients(mesh(), distance());
+      for (auto& g : n) g = unit(g);
+    } else {
+      n.assign(mesh().n_vertices(), Vec3(0, 0, 0));
+      for (int v : active) n[v] = unit(bodyfit::vertex_gradient(mesh(), VertexHandle(v), distance()));
     }
     impl_->conormal = std::move(n);
   }

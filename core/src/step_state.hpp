@@ -3,8 +3,17 @@
 #include <bodyfit/velocity_model.hpp>
 
 #include <filesystem>
+#include <mutex>
+#include <optional>
+#include <span>
 
 namespace bodyfit {
+
+/// Geometry shared by the contexts of one step on one mesh (the CFL sub-steps): computed once.
+struct StepGeometry {
+  std::mutex mutex;
+  std::optional<VectorField> vertex_normals;
+};
 
 struct StepState {
   const SurfaceMesh* mesh = nullptr;      ///< T^n (garbage-collected)
@@ -13,6 +22,8 @@ struct StepState {
   int iteration = 0;
   std::filesystem::path output_dir;
   bool terrain = false;                   ///< S is a height field z(x, y)
+  std::span<const int> active;            ///< narrow band: where V is needed (empty: every vertex)
+  StepGeometry* geometry = nullptr;       ///< shared with the other contexts of the step (optional)
 };
 
 /// The context for one (sub-)step or candidate; `state`'s pointers must outlive it.

@@ -11,6 +11,19 @@
 namespace bodyfit::fire {
 namespace {
 
+/// Barycentric coordinates of (x, y) in the plan view of the triangle p, when it lies inside.
+bool plan_barycentric(const std::array<Vec3, 3>& p, double x, double y, std::array<double, 3>& bary) {
+  const double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+  if (det == 0) return false;
+  const double l1 = ((x - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (y - p[0][1])) / det;
+  const double l2 = ((p[1][0] - p[0][0]) * (y - p[0][1]) - (x - p[0][0]) * (p[1][1] - p[0][1])) / det;
+  const double l0 = 1 - l1 - l2;
+  constexpr double eps = -1e-9;
+  if (l0 < eps || l1 < eps || l2 < eps) return false;
+  bary = {l0, l1, l2};
+  return true;
+}
+
 // Faces bucketed on a regular grid in plan view, to find the face above a point (x, y) of a
 // terrain (a height field: its projection on the plane is one-to-one).
 class PlanLocator {
@@ -36,19 +49,8 @@ class PlanLocator {
   /// The face above (x, y) and the barycentric coordinates there; invalid face when outside.
   FaceHandle locate(double x, double y, std::array<double, 3>& bary) const {
     long i = index(x, x0_, nx_), j = index(y, y0_, ny_);
-    for (FaceHandle f : buckets_[std::size_t(j * nx_ + i)]) {
-      auto p = face_points(mesh_, f);
-      double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-      if (det == 0) continue;
-      double l1 = ((x - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (y - p[0][1])) / det;
-      double l2 = ((p[1][0] - p[0][0]) * (y - p[0][1]) - (x - p[0][0]) * (p[1][1] - p[0][1])) / det;
-      double l0 = 1 - l1 - l2;
-      const double eps = -1e-9;
-      if (l0 >= eps && l1 >= eps && l2 >= eps) {
-        bary = {l0, l1, l2};
-        return f;
-      }
-    }
+    for (FaceHandle f : buckets_[std::size_t(j * nx_ + i)])
+      if (plan_barycentric(face_points(mesh_, f), x, y, bary)) return f;
     return FaceHandle();
   }
 
@@ -119,26 +121,59 @@ void ArrivalRaster::load(const ModelState& state) {
   grid_.rows = std::size_t(size[1]);
   grid_.x_origin = frame[0], grid_.y_origin = frame[1], grid_.cell_size = frame[2], grid_.nodata = frame[3];
   grid_.heights = times;
+  swept_ = true;  // the state comes from a run past its first update
 }
 
 void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next,
-                           double time, double dt) {
-  PlanLocator locator(mesh, 2 * edge_length_stats(mesh).mean);
-  for (std::size_t row = 0; row < grid_.rows; ++row)
-    for (std::size_t col = 0; col < grid_.cols; ++col) {
-      double& arrival = grid_.heights[row * grid_.cols + col];
-      if (!std::isnan(arrival)) continue;
-      std::array<double, 3> bary;
-      FaceHandle f = locator.locate(cell_center_x(grid_, col), cell_center_y(grid_, row), bary);
-      if (!f.is_valid()) continue;
-      auto vs = face_vertices(mesh, f);
-      double d = 0, phi = 0;
-      for (int k = 0; k < 3; ++k) {
-        d += bary[k] * distance[vs[k].idx()];
-        phi += bary[k] * phi_next[vs[k].idx()];
+                           double time, double dt, std::span<const int> changed) {
+  auto reach = [&](double& arrival, FaceHandle f, const std::array<double, 3>& bary) {
+    auto vs = face_vertices(mesh, f);
+    double d = 0, phi = 0;
+    for (int k = 0; k < 3; ++k) {
+      d += bary[k] * distance[vs[k].idx()];
+      phi += bary[k] * phi_next[vs[k].idx()];
+    }
+    if (d <= 0) arrival = time;  // already burnt at t^n (the initial region)
+    else if (phi <= 0) arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
+  };
+  if (!swept_ || changed.empty()) {
+    PlanLocator locator(mesh, 2 * edge_length_stats(mesh).mean);
+    for (std::size_t row = 0; row < grid_.rows; ++row)
+      for (std::size_t col = 0; col < grid_.cols; ++col) {
+        double& arrival = grid_.heights[row * grid_.cols + col];
+        if (!std::isnan(arrival)) continue;
+        std::array<double, 3> bary;
+        FaceHandle f = locator.locate(cell_center_x(grid_, col), cell_center_y(grid_, row), bary);
+        if (f.is_valid()) reach(arrival, f, bary);
       }
-      if (d <= 0) arrival = time;  // already burnt at t^n (the initial region)
-      else if (phi <= 0) arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
+    swept_ = true;
+    return;
+  }
+  // The cells whose centres lie under a face around a changed vertex, each face once.
+  face_seen_.resize(mesh.n_faces(), 0);
+  const std::uint32_t epoch = ++epoch_;
+  const double cell = grid_.cell_size;
+  for (int v : changed)
+    for (FaceHandle f : mesh.vf_range(VertexHandle(v))) {
+      if (face_seen_[f.idx()] == epoch) continue;
+      face_seen_[f.idx()] = epoch;
+      const auto p = face_points(mesh, f);
+      const double xmin = std::min({p[0][0], p[1][0], p[2][0]}), xmax = std::max({p[0][0], p[1][0], p[2][0]});
+      const double ymin = std::min({p[0][1], p[1][1], p[2][1]}), ymax = std::max({p[0][1], p[1][1], p[2][1]});
+      // Columns with x_origin + (c + ½)·cell in [xmin, xmax]; rows likewise from the south.
+      const long c0 = std::max(0L, long(std::ceil((xmin - grid_.x_origin) / cell - 0.5)));
+      const long c1 = std::min(long(grid_.cols) - 1, long(std::floor((xmax - grid_.x_origin) / cell - 0.5)));
+      const long s0 = std::max(0L, long(std::ceil((ymin - grid_.y_origin) / cell - 0.5)));
+      const long s1 = std::min(long(grid_.rows) - 1, long(std::floor((ymax - grid_.y_origin) / cell - 0.5)));
+      for (long south = s0; south <= s1; ++south)
+        for (long col = c0; col <= c1; ++col) {
+          const std::size_t row = grid_.rows - 1 - std::size_t(south);
+          double& arrival = grid_.heights[row * grid_.cols + std::size_t(col)];
+          if (!std::isnan(arrival)) continue;
+          std::array<double, 3> bary;
+          if (plan_barycentric(p, cell_center_x(grid_, std::size_t(col)), cell_center_y(grid_, row), bary))
+            reach(arrival, f, bary);
+        }
     }
 }
 

@@ -4,7 +4,10 @@
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/model_state.hpp>
 
+#include <cstdint>
 #include <filesystem>
+#include <span>
+#include <vector>
 #include <string>
 
 namespace bodyfit::fire {
@@ -32,7 +35,11 @@ class ArrivalRaster {
  public:
   bool initialised() const { return grid_.cols > 0; }
   void initialise(const SurfaceMesh& mesh, double cell_size, const HeightGrid& like, double mesh_size);
-  void update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next, double time, double dt);
+  /// One (sub-)step: φ went from `distance` to `phi_next`, changing only at the vertices `changed`
+  /// (all when empty). After the first update, which sweeps every cell (the initial region), only
+  /// the cells under the faces around `changed` can be reached, and only those are visited.
+  void update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next, double time, double dt,
+              std::span<const int> changed = {});
   /// Arrival time at the vertices (bilinear over reached cells; NaN where none is reached yet).
   ScalarField sample_at_vertices(const SurfaceMesh& mesh) const;
   void write(const std::filesystem::path& file) const;
@@ -44,6 +51,9 @@ class ArrivalRaster {
 
  private:
   HeightGrid grid_;  ///< heights hold the arrival times (NaN = not reached)
+  bool swept_ = false;  ///< every cell visited once (the initial region is in the raster)
+  std::vector<std::uint32_t> face_seen_;  ///< = epoch_ for the faces visited by this update
+  std::uint32_t epoch_ = 0;
 };
 
 }  // namespace bodyfit::fire

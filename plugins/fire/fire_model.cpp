@@ -131,22 +131,25 @@ class FireModel final : public VelocityModel {
     if (context.is_terrain() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
 
     ScalarField speed(mesh.n_vertices(), 0.0);
-    for (auto v : mesh.vertices()) {
-      const Vec3& x = mesh.point(v);
+    auto rate_at = [&](int v) {
+      const Vec3& x = mesh.point(VertexHandle(v));
       const BalbiParameters* fuel = fuel_at(x);
-      if (!fuel) continue;  // not burnable: the front stops here
-      const Vec3& n_sigma = conormal[v.idx()];
-      if (n_sigma.sqrnorm() == 0) {
-        speed[v.idx()] = fuel->R0;
-        continue;
-      }
-      const Vec3& normal = normals[v.idx()];
+      if (!fuel) return 0.0;  // not burnable: the front stops here
+      const Vec3& n_sigma = conormal[v];
+      if (n_sigma.sqrnorm() == 0) return fuel->R0;
+      const Vec3& normal = normals[v];
       // ∇_S s · n_Σ = e3 · n_Σ because n_Σ is tangent (∇_S s = e3 − (e3·N)N).
       double slope_term = n_sigma[2];
       double wind_term = OpenMesh::dot(wind_.at(x), n_sigma);
       double tan_gamma = tan_tilt(slope_term, std::abs(normal[2]), wind_term, *fuel);
-      speed[v.idx()] = rate_of_spread(std::atan(tan_gamma), *fuel);
+      return rate_of_spread(std::atan(tan_gamma), *fuel);
+    };
+    // A sub-step in a narrow band needs R at the band's vertices only, and no metrics or fields.
+    if (const std::span<const int> active = context.active_vertices(); !active.empty()) {
+      for (int v : active) speed[v] = rate_at(v);
+      return VelocityField::normal(std::move(speed));
     }
+    for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
 
     VelocityField field = VelocityField::normal(speed);
     // Rate of spread on the front: vertices of interface edges.
@@ -178,7 +181,8 @@ class FireModel final : public VelocityModel {
   }
 
   void end_step(const StepOutcome& outcome) override {
-    if (arrival_.initialised()) arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt);
+    if (arrival_.initialised())
+      arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt, outcome.changed);
   }
 
   // What a resumed run needs to continue exactly: the arrival times so far and the rotating wind's

@@ -79,7 +79,16 @@ struct EvolutionOptions {
   /// what remains of the step; the mesh, its regions and interface edges are those of T^n, the
   /// distance and the conormal those of the moved front), its metrics are those of the first.
   /// A model with ModelNeeds::freeze_velocity is asked once per step and its V advects every sub-step.
+  /// Only the front matters: max|V| is taken over the vertices within the band's width of Σ (see
+  /// narrow_band), where the front can be within the step's reach.
   double max_cfl = 0;
+  /// With max_cfl, work near the front only: the sub-steps after the first redistance φ, ask the
+  /// model for V (StepContext::active_vertices) and advect φ in a band of width 2·max_cfl·h + 4·ĥ
+  /// (ĥ the longest edge) around the moving front, tracing the vertices within max_cfl·h + 2·ĥ:
+  /// the front cannot leave that within a sub-step, so the result is the whole surface's (the
+  /// vertices beyond keep their sign). A sub-step then costs what the band holds, not the mesh.
+  /// false: every stage on the whole surface (the reference the band is tested against).
+  bool narrow_band = true;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   double final_time = std::numeric_limits<double>::infinity();
   long max_iterations = -1;      ///< stop when the iteration counter reaches this (−1: no limit)

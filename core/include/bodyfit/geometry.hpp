@@ -5,6 +5,7 @@
 
 #include <array>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace bodyfit {
@@ -73,6 +74,16 @@ double total_area(const SurfaceMesh& mesh);
 double region_area(const SurfaceMesh& mesh, int region);
 /// Total length of the edges tagged as interface.
 double interface_length(const SurfaceMesh& mesh);
+/// Line segments in space (an interface as its edges).
+using Segment = std::pair<Vec3, Vec3>;
+using Segments = std::vector<Segment>;
+Segments interface_segments(const SurfaceMesh& mesh);
+/// Hausdorff distance between two sets of segments: the largest distance from an end or midpoint
+/// of a segment of either to the other set (3-D, brute force: for tests and benchmarks). ∞ when
+/// only one is empty, 0 when both are.
+double hausdorff_distance(const Segments& a, const Segments& b);
+/// The same between the interfaces of two meshes of one surface.
+double interface_hausdorff(const SurfaceMesh& a, const SurfaceMesh& b);
 
 /// (∫_S (u_h − u)²)^½ for a P1 field u_h and an exact function u, with the edge-midpoint rule on
 /// each flat triangle (exact for quadratics): the error measure E of the paper's (4.5).

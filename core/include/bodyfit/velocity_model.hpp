@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -32,7 +33,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 0;
+inline constexpr std::uint32_t kPluginAbiMinor = 1;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// One parameter a model accepts, for `bodyfit plugins` and for error messages.
@@ -102,6 +103,12 @@ class StepContext {
   const std::filesystem::path& output_dir() const;  ///< where a model may write its own files
   /// The surface's height function when it is a terrain (z coordinate), else empty.
   bool is_terrain() const;
+  /// The vertices where V is needed (ABI 2.1). In the CFL sub-steps after the first, the driver
+  /// works in a narrow band around Σ: it reads V only at these vertices, ignores the metrics and
+  /// fields, and distance() is the distance only there (beyond, its sign is right and |d| is at
+  /// least the band's width). conormal() is then filled only at these vertices. A model may
+  /// compute everywhere anyway (correct, slower). Empty: every vertex (the state's own compute).
+  std::span<const int> active_vertices() const;
 
   const std::vector<double>& face_areas() const;
   const VectorField& face_normals() const;
@@ -132,6 +139,9 @@ struct StepOutcome {
   double time;                      ///< time at the start of this (sub-)step
   double dt;                        ///< its length
   int attempt;                      ///< 0, then 1, 2… when the step is retried after a rejection
+  /// The vertices where phi_next may differ from distance (ABI 2.1; a narrow band: φ was advected
+  /// only there). Empty: anywhere.
+  std::span<const int> changed = {};
 };
 
 /// What a model needs from the driver (asked once, after configure).

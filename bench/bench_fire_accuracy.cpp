@@ -1,0 +1,194 @@
+// Accuracy and cost of the fire cases' CFL sub-steps: the narrow band against the whole surface
+// and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/performance.md).
+//
+//   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--iterations N]
+//                       [--reference-factor 4] [-o out.csv]
+//
+// Runs the case three times from the same T^0: "band" (the case as shipped: its max_cfl, sub-steps
+// in a narrow band), "whole" (the same sub-steps on the whole surface) and "reference" (max_cfl
+// divided by the factor, whole surface). After every step it records the time per iteration, the
+// sub-steps, the components of G and its area, and the gap between its front and the reference's
+// at the same time (the distances from every end and midpoint of either front's edges to the other:
+// mean, 95th percentile, max), in units of the case's h. Prints a summary (the worst step of each,
+// the step where G becomes one component, the most components) and writes one CSV row per run and step.
+#include "bench_args.hpp"
+
+#include <bodyfit/case_config.hpp>
+#include <bodyfit/evolution.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/plugin_loader.hpp>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+using namespace bodyfit;
+
+namespace {
+
+/// Distances between two fronts: from every end and midpoint of a segment of either to the other.
+struct FrontGap {
+  double mean = 0, p95 = 0, max = 0;
+};
+
+double to_segments(const Vec3& p, const Segments& to) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& [a, b] : to) {
+    const Vec3 e = b - a;
+    const double len2 = e.sqrnorm();
+    const double t = len2 > 0 ? std::clamp(OpenMesh::dot(p - a, e) / len2, 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (p - (a + t * e)).norm());
+  }
+  return nearest;
+}
+
+FrontGap front_gap(const Segments& a, const Segments& b) {
+  std::vector<double> d;
+  for (const auto* pair : {&a, &b})
+    for (const auto& [p, q] : *pair)
+      for (const Vec3& x : {p, q, 0.5 * (p + q)}) d.push_back(to_segments(x, pair == &a ? b : a));
+  if (d.empty()) return {};
+  std::sort(d.begin(), d.end());
+  FrontGap g;
+  for (double x : d) g.mean += x / double(d.size());
+  g.p95 = d[std::size_t(0.95 * double(d.size() - 1))];
+  g.max = d.back();
+  return g;
+}
+
+struct StepRecord {
+  int iteration = 0;
+  double time = 0, area = 0, ms = 0, band_error = 0;
+  FrontGap gap;  ///< to the reference's front at the same step
+  int components = 0;
+  std::size_t faces = 0;
+  int substeps = 0;
+  Segments front;
+};
+
+struct Run {
+  std::string name;
+  std::vector<StepRecord> steps;
+  double wall_s = 0;
+  double h = 0;  ///< the case's h (hmax, or the mean edge of T^0)
+};
+
+Run run(const std::string& name, const CaseConfig& config, double max_cfl, bool narrow_band, int iterations) {
+  LoadedModel model = load_model(config.model);
+  configure_model(model, config.model_parameters);
+  CaseSetup setup = setup_case(config);
+  setup.options.max_cfl = max_cfl;
+  setup.options.narrow_band = narrow_band;
+  if (iterations >= 0) setup.options.max_iterations = iterations;
+  Run r{name, {}, 0, setup.h};
+  EvolutionHooks hooks = EvolutionHooks::quiet();
+  hooks.on_iteration = [&](const SurfaceMesh& mesh, const IterationRecord& record, const RunState&) {
+    StepRecord s;
+    s.iteration = record.iteration;
+    s.time = record.time;
+    s.area = record.area;
+    s.ms = record.ms.total();
+    s.components = record.components;
+    s.faces = record.faces;
+    s.substeps = record.substeps;
+    s.front = interface_segments(mesh);
+    r.steps.push_back(std::move(s));
+  };
+  const auto start = std::chrono::steady_clock::now();
+  evolve(setup.mesh, model.model(), setup.options, {}, hooks);
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+/// The first step after which G has one component (−1: never).
+int merge_step(const Run& r) {
+  for (const auto& s : r.steps)
+    if (s.components == 1) return s.iteration;
+  return -1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::filesystem::path case_file = "meshes/cases/fire_four_disks.toml";
+  double h = 0;
+  int iterations = -1;
+  double factor = 4;
+  std::filesystem::path csv_path = "bench_fire_accuracy.csv";
+  bench::Arguments args("bench_fire_accuracy",
+                        "usage: bench_fire_accuracy [--case file.toml] [--h H] [--iterations N] [--reference-factor 4] "
+                        "[-o out.csv]\n"
+                        "  --case              fire case with max_cfl > 0 (default meshes/cases/fire_four_disks.toml)\n"
+                        "  --h                 surface.h and remesh.hmax in metres (default: the case's)\n"
+                        "  --iterations        steps to run (default: the case's final time)\n"
+                        "  --reference-factor  the reference divides max_cfl by this (default 4)\n"
+                        "  -o                  CSV, one row per run and step (default bench_fire_accuracy.csv)\n");
+  args.option("--case", case_file);
+  args.option("--h", h);
+  args.option("--iterations", iterations);
+  args.option("--reference-factor", factor);
+  args.option("-o", csv_path);
+  args.parse(argc, argv);
+  if (!(factor >= 1)) args.fail("--reference-factor must be at least 1");
+  spdlog::set_level(spdlog::level::warn);
+
+  std::vector<std::string> overrides;
+  if (h > 0) overrides = {fmt::format("surface.h={}", h), fmt::format("remesh.hmax={}", h)};
+  const CaseConfig config = read_case(case_file, overrides);
+  const double max_cfl = config.time.max_cfl;
+  if (!(max_cfl > 0)) args.fail("the case has no max_cfl: nothing to compare");
+  std::vector<Run> runs;
+  runs.push_back(run("reference", config, max_cfl / factor, false, iterations));
+  runs.push_back(run("band", config, max_cfl, true, iterations));
+  runs.push_back(run("whole", config, max_cfl, false, iterations));
+  const Run& reference = runs[0];
+  const double length = reference.h;
+  std::map<int, const StepRecord*> by_iteration;
+  for (const auto& s : reference.steps) by_iteration[s.iteration] = &s;
+
+  std::ofstream csv(csv_path);
+  csv << "run,iteration,time,faces,substeps,components,area,ms_total,gap_mean_h,gap_p95_h,gap_max_h,band_gap_max_h\n";
+  fmt::print("{}: h = {} m, max_cfl {} (reference {}), {} steps\n", case_file.string(), length, max_cfl,
+             max_cfl / factor, reference.steps.size());
+  fmt::print("{:>10} {:>8} {:>8} {:>9} {:>6} {:>5} | gap to reference / h, worst step: {:>6} {:>6} {:>6} | {:>7}\n",
+             "run", "wall s", "ms/step", "sub-steps", "merge", "comp", "mean", "p95", "max", "vs band");
+  const Run* band = &runs[1];
+  for (auto& r : runs) {
+    double worst = 0, worst_mean = 0, worst_p95 = 0, ms = 0, worst_band = 0;
+    int substeps = 0;
+    int most = 0;
+    for (std::size_t k = 0; k < r.steps.size(); ++k) {
+      auto& s = r.steps[k];
+      auto it = by_iteration.find(s.iteration);
+      if (it != by_iteration.end()) s.gap = front_gap(s.front, it->second->front);
+      if (&r != band && k < band->steps.size()) {
+        s.band_error = hausdorff_distance(s.front, band->steps[k].front) / length;
+        worst_band = std::max(worst_band, s.band_error);
+      }
+      worst = std::max(worst, s.gap.max / length);
+      worst_mean = std::max(worst_mean, s.gap.mean / length);
+      worst_p95 = std::max(worst_p95, s.gap.p95 / length);
+      ms += s.ms;
+      substeps += s.substeps;
+      most = std::max(most, s.components);
+      csv << fmt::format("{},{},{},{},{},{},{:.9g},{:.1f},{:.4f},{:.4f},{:.4f},{:.4f}\n", r.name, s.iteration, s.time,
+                         s.faces, s.substeps, s.components, s.area, s.ms, s.gap.mean / length, s.gap.p95 / length,
+                         s.gap.max / length, s.band_error);
+    }
+    const double n = std::max<std::size_t>(1, r.steps.size());
+    fmt::print("{:>10} {:>8.1f} {:>8.0f} {:>9.1f} {:>6} {:>5} |                                   {:>6.3f} {:>6.3f} {:>6.3f} | "
+               "{:>7.3f}\n",
+               r.name, r.wall_s, ms / n, substeps / n, merge_step(r), most, worst_mean, worst_p95, worst,
+               &r == band ? 0.0 : worst_band);
+  }
+  fmt::print("wrote {}\n", csv_path.string());
+  return 0;
+}
