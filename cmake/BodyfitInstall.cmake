@@ -1,5 +1,7 @@
 include(CMakePackageConfigHelpers)
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/core/include/bodyfit DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The headers only: config.hpp.in stays in the source tree, its generated config.hpp is installed.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/core/include/bodyfit DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+        FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
 install(FILES ${PROJECT_BINARY_DIR}/core/include/bodyfit/config.hpp
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/bodyfit)
 install(EXPORT bodyfitTargets NAMESPACE bodyfit:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bodyfit)

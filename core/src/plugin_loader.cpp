@@ -73,8 +73,9 @@ std::vector<fs::path> plugin_files(const fs::path& dir) {
 }
 
 /// The plugin directory next to the libbodyfit_core actually loaded (<libdir>/bodyfit/plugins):
-/// the build tree and any install prefix share this layout, so an installed tree that was moved
-/// or installed with `cmake --install --prefix` still finds its own plugins.
+/// the build tree and any install prefix share this layout, so a build tree, an installed tree,
+/// one that was moved or one installed with `cmake --install --prefix` each find their own plugins.
+/// No path of the build tree is compiled in: the installed library holds none.
 fs::path plugin_dir_beside_core() {
   static const char anchor = 0;
   Dl_info info;
@@ -82,7 +83,7 @@ fs::path plugin_dir_beside_core() {
   std::error_code ec;
   fs::path library = fs::weakly_canonical(fs::path(info.dli_fname), ec);
   if (ec) return {};
-  return library.parent_path() / "bodyfit" / "plugins";
+  return library.parent_path() / config::plugin_dir_from_libdir;
 }
 
 }  // namespace
@@ -140,8 +141,7 @@ std::vector<fs::path> plugin_search_path() {
       rest.remove_prefix(colon + 1);
     }
   }
-  add(plugin_dir_beside_core());
-  add(config::plugin_build_dir);
+  add(plugin_dir_beside_core());  // the build tree's when running from it, else the prefix's
   add(config::plugin_install_dir);
   return dirs;
 }

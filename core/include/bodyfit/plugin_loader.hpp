@@ -3,8 +3,8 @@
 //
 // Search order: the directories of BODYFIT_PLUGIN_PATH (colon-separated), the plugin directory
 // beside the loaded libbodyfit_core (<libdir>/bodyfit/plugins: the build tree's or the install
-// prefix's, wherever the tree now lives), the build tree's plugin directory, the configured
-// install prefix's plugin directory (duplicates dropped). Every failure (no such model, dlopen error,
+// prefix's, wherever the tree now lives; no build path is compiled in), the configured install
+// prefix's plugin directory (duplicates dropped). Every failure (no such model, dlopen error,
 // missing symbol, ABI mismatch, throwing constructor) is an InputError naming the file and reason.
 // The ABI (major << 16 | minor) is checked before anything else: the major must equal ours and the
 // plugin's minor must not exceed ours (a plugin built against older headers of the same major loads).
@@ -40,11 +40,6 @@ class LoadedModel {
 
  private:
   friend LoadedModel load_plugin_file(const std::filesystem::path& file);
-/// Call model.configure(parameters); any exception becomes InputError
-/// "<file>: configure failed: <reason>".
-void configure_model(LoadedModel& model, const toml::table& parameters);
-/// Decode kPluginAbi-style numbers: "1.0".
-std::string abi_string(std::uint32_t abi);
   void reset();
   void* handle_ = nullptr;
   VelocityModel* model_ = nullptr;
