@@ -11,9 +11,16 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace bodyfit {
 namespace io_detail {
@@ -32,19 +39,71 @@ std::string extension_of(const std::filesystem::path& file) {
 }
 
 std::string read_file_bytes(const std::filesystem::path& file) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(file.c_str(), "rb"), &std::fclose);
-  if (!in) throw file_error(file, fmt::format("cannot open for reading ({})", std::strerror(errno)));
-  if (std::filesystem::is_directory(file)) throw file_error(file, "cannot read: it is a directory");
-  std::string bytes;
-  char chunk[1 << 16];
-  std::size_t got;
-  std::error_code ec;
-  auto size = std::filesystem::file_size(file, ec);
-  if (!ec) bytes.reserve(size);
-  while ((got = std::fread(chunk, 1, sizeof chunk, in.get())) > 0) bytes.append(chunk, got);
-  if (std::ferror(in.get())) throw file_error(file, "read error");
-  return bytes;
+  return std::string(FileBytes(file).view());
 }
+
+FileBytes::FileBytes(const std::filesystem::path& file) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw file_error(file, fmt::format("cannot open for reading ({})", std::strerror(errno)));
+  struct stat st {};
+  const bool stated = ::fstat(fd, &st) == 0;
+  if (stated && S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    throw file_error(file, "cannot read: it is a directory");
+  }
+  auto fail = [&](int error) {
+    ::close(fd);
+    return file_error(file, fmt::format("read error ({})", std::strerror(error)));
+  };
+  if (stated && S_ISREG(st.st_mode) && std::size_t(st.st_size) >= kBulkThreshold) {
+    // A big regular file: one read into huge-page memory (bulk_allocate).
+    capacity_ = std::size_t(st.st_size);
+    data_ = static_cast<char*>(bulk_allocate(capacity_));
+    while (size_ < capacity_) {
+      const ssize_t got = ::read(fd, data_ + size_, capacity_ - size_);
+      if (got == 0) break;  // shrunk meanwhile: what there is
+      if (got < 0) {
+        if (errno == EINTR) continue;
+        const int error = errno;
+        bulk_free(data_, capacity_);
+        data_ = nullptr;
+        throw fail(error);
+      }
+      size_ += std::size_t(got);
+    }
+    ::close(fd);
+    return;
+  }
+  // Small files, pipes, /proc: read in blocks.
+  if (stated && S_ISREG(st.st_mode)) copy_.reserve(std::size_t(st.st_size));
+  char chunk[1 << 16];
+  for (;;) {
+    const ssize_t got = ::read(fd, chunk, sizeof chunk);
+    if (got == 0) break;
+    if (got < 0) {
+      if (errno == EINTR) continue;
+      throw fail(errno);
+    }
+    copy_.append(chunk, std::size_t(got));
+  }
+  ::close(fd);
+}
+
+FileBytes::~FileBytes() {
+  if (data_) bulk_free(data_, capacity_);
+}
+
+void* bulk_allocate(std::size_t bytes) {
+  // Aligned on 2 MiB and a multiple of it (aligned_alloc's rule), so every page of the block can
+  // be huge. From malloc: a process that already freed such blocks gets them back, faulted in.
+  const std::size_t size = (bytes + kBulkThreshold - 1) / kBulkThreshold * kBulkThreshold;
+  void* p = std::aligned_alloc(kBulkThreshold, size);
+  if (!p) throw std::bad_alloc();
+  ::madvise(p, size, MADV_HUGEPAGE);  // a hint: no huge pages is fine too
+  return p;
+}
+
+void bulk_free(void* p, std::size_t) { std::free(p); }
 
 std::vector<std::int64_t> vertex_numbering(const SurfaceMesh& mesh) {
   std::vector<std::int64_t> index(mesh.n_vertices(), -1);
@@ -190,7 +249,7 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     mesh.edge_ref(e) = i < r.edge_refs.size() ? r.edge_refs[i] : 0;
     if (mesh.edge_ref(e) == kInterfaceRef) mesh.interface(e) = 1;
   }
-  auto edge_list_item = [&](const std::vector<std::int64_t>& items, const Locator& at, const char* section,
+  auto edge_list_item = [&](const BulkVector<std::int64_t>& items, const Locator& at, const char* section,
                             std::size_t k) {
     auto i = items[k];
     if (i < 0 || i >= std::int64_t(listed.size()))
@@ -202,7 +261,7 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   for (std::size_t k = 0; k < r.ridges.size(); ++k) mesh.ridge(edge_list_item(r.ridges, r.ridge_at, "Ridges", k)) = 1;
   for (std::size_t k = 0; k < r.required_edges.size(); ++k)
     mesh.required(edge_list_item(r.required_edges, r.required_edge_at, "RequiredEdges", k)) = 1;
-  auto vertex_list_item = [&](const std::vector<std::int64_t>& items, const Locator& at, const char* section,
+  auto vertex_list_item = [&](const BulkVector<std::int64_t>& items, const Locator& at, const char* section,
                               std::size_t k) {
     auto i = items[k];
     if (i < 0 || i >= nv)

@@ -12,10 +12,12 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <string_view>
 
 namespace bodyfit::io_detail {
@@ -102,7 +104,7 @@ int solution_size(int type, int dimension) {
 
 class TextScanner {
  public:
-  TextScanner(const std::string& text, const fs::path& file)
+  TextScanner(std::string_view text, const fs::path& file)
       : p_(text.data()), end_(text.data() + text.size()), file_(file) {}
 
   /// Skip whitespace and comments; true when a token follows.
@@ -218,7 +220,7 @@ class TextScanner {
 
 class BinaryScanner {
  public:
-  BinaryScanner(const std::string& bytes, const fs::path& file) : bytes_(bytes), file_(file) {}
+  BinaryScanner(std::string_view bytes, const fs::path& file) : bytes_(bytes), file_(file) {}
 
   std::size_t pos() const { return pos_; }
   void seek(std::size_t pos) { pos_ = pos; }
@@ -228,11 +230,18 @@ class BinaryScanner {
   InputError error(std::size_t at, const std::string& what) const {
     return file_error(file_, fmt::format("byte {}: {}", at, what));
   }
+  std::size_t left() const { return bytes_.size() - std::min(pos_, bytes_.size()); }
   /// Check that n more bytes exist.
   void need(std::size_t n, const std::string& what) const {
-    if (n > bytes_.size() - std::min(pos_, bytes_.size()))
-      throw error(pos_, fmt::format("unexpected end of file: expected {} ({} bytes, {} left)", what, n,
-                                    bytes_.size() - std::min(pos_, bytes_.size())));
+    if (n > left())
+      throw error(pos_, fmt::format("unexpected end of file: expected {} ({} bytes, {} left)", what, n, left()));
+  }
+  /// Check that `count` records of `size` bytes exist, without computing count·size (a corrupt
+  /// 64-bit count would overflow it).
+  void need_records(std::uint64_t count, std::size_t size, const std::string& what) const {
+    if (count > left() / size)
+      throw error(pos_, fmt::format("unexpected end of file: expected {} ({} x {} bytes, {} left)", what, count, size,
+                                    left()));
   }
 
   template <class T>
@@ -259,7 +268,7 @@ class BinaryScanner {
     return value;
   }
 
-  const std::string& bytes_;
+  std::string_view bytes_;
   const fs::path& file_;
   std::size_t pos_ = 0;
   bool swap_ = false;
@@ -344,7 +353,7 @@ bool plausible_count(std::int64_t count, std::size_t remaining, std::size_t min_
   return count >= 0 && std::uint64_t(count) <= remaining / min_bytes + 1;
 }
 
-MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
+MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
   TextScanner in(text, file);
   MeshRecords r;
   MeshHeader header;
@@ -355,9 +364,15 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
       throw in.error(fmt::format("record count {} of {} does not fit in the rest of the file", n, section));
     return n;
   };
-  auto index_list = [&](const char* section, std::vector<std::int64_t>& items, Locator& at) {
+  // What to reserve for n records of k numbers: a record takes at least 2k characters (a digit
+  // and a separator each), so a count larger than the file allows (an error further on, when the
+  // records run out) does not allocate more than the file could hold.
+  auto room = [&](std::int64_t n, int k) {
+    return std::min(std::size_t(n), in.remaining() / (2 * std::size_t(k)) + 1);
+  };
+  auto index_list = [&](const char* section, BulkVector<std::int64_t>& items, Locator& at) {
     auto n = count_of(section);
-    items.reserve(items.size() + std::size_t(n));
+    items.reserve(items.size() + room(n, 1));
     for (std::int64_t i = 0; i < n; ++i) {
       in.set_context(section, i, n);
       in.skip_blank();
@@ -385,9 +400,9 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
       check_dimension(header.dimension, [&](const std::string& w) { return in.error(w); });
     } else if (word == "Vertices") {
       auto n = count_of("Vertices");
-      r.points.reserve(std::size_t(n));
-      r.vertex_refs.reserve(std::size_t(n));
-      r.vertex_at.reserve(std::size_t(n));
+      r.points.reserve(room(n, header.dimension + 1));
+      r.vertex_refs.reserve(room(n, header.dimension + 1));
+      r.vertex_at.reserve(room(n, header.dimension + 1));
       for (std::int64_t i = 0; i < n; ++i) {
         in.set_context("Vertices", i, n);
         in.skip_blank();
@@ -401,9 +416,9 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
       }
     } else if (word == "Triangles") {
       auto n = count_of("Triangles");
-      r.triangles.reserve(std::size_t(n));
-      r.triangle_refs.reserve(std::size_t(n));
-      r.triangle_at.reserve(std::size_t(n));
+      r.triangles.reserve(room(n, 4));
+      r.triangle_refs.reserve(room(n, 4));
+      r.triangle_at.reserve(room(n, 4));
       for (std::int64_t i = 0; i < n; ++i) {
         in.set_context("Triangles", i, n);
         in.skip_blank();
@@ -415,8 +430,8 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
       }
     } else if (word == "Edges") {
       auto n = count_of("Edges");
-      r.edges.reserve(std::size_t(n));
-      r.edge_refs.reserve(std::size_t(n));
+      r.edges.reserve(room(n, 3));
+      r.edge_refs.reserve(room(n, 3));
       for (std::int64_t i = 0; i < n; ++i) {
         in.set_context("Edges", i, n);
         in.skip_blank();
@@ -458,7 +473,7 @@ MeshRecords read_medit_text(const std::string& text, const fs::path& file) {
   return r;
 }
 
-MeshRecords read_medit_binary(const std::string& bytes, const fs::path& file) {
+MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   BinaryScanner in(bytes, file);
   const BinaryFormat format = read_binary_header(in);
   MeshRecords r;
@@ -471,11 +486,10 @@ MeshRecords read_medit_binary(const std::string& bytes, const fs::path& file) {
   };
   auto records = [&](const char* section, std::size_t record_size) {
     auto n = read_count(in, format, section);
-    if (std::uint64_t(n) > (in.size() - in.pos()) / record_size)
-      in.need(std::size_t(n) * record_size, fmt::format("{} records of {}", n, section));
+    in.need_records(std::uint64_t(n), record_size, fmt::format("{} records of {}", n, section));
     return n;
   };
-  auto index_list = [&](const char* section, std::vector<std::int64_t>& items, Locator& at) {
+  auto index_list = [&](const char* section, BulkVector<std::int64_t>& items, Locator& at) {
     auto n = records(section, format.int_size());
     at = Locator::bytes(in.pos(), format.int_size());
     for (std::int64_t i = 0; i < n; ++i) items.push_back(read_index() - 1);
@@ -539,28 +553,49 @@ MeshRecords read_medit_binary(const std::string& bytes, const fs::path& file) {
 // ---------------------------------------------------------------------------------------------
 // Writing.
 
-/// Buffered output to the stream of write_atomically.
+/// Buffered output to the stream of write_atomically: numbers are formatted with std::to_chars
+/// (shortest round-trip form for doubles, so a text round trip is bit-exact) or copied as bytes
+/// straight into a block handed to the stream when full. One check per value: the block has
+/// room for the longest value past its nominal size.
 class OutputBuffer {
  public:
-  explicit OutputBuffer(std::ostream& out) : out_(out) {}
-  ~OutputBuffer() = default;
-  fmt::memory_buffer& text() { return buffer_; }
+  explicit OutputBuffer(std::ostream& out)
+      : out_(out), data_(std::make_unique_for_overwrite<char[]>(kBlock + kSlack)), p_(data_.get()) {}
+  void real(double x) {
+    make_room();
+    p_ = std::to_chars(p_, p_ + kSlack, x).ptr;
+  }
+  void integer(std::int64_t i) {
+    make_room();
+    p_ = std::to_chars(p_, p_ + kSlack, i).ptr;
+  }
+  void put(char c) {
+    make_room();
+    *p_++ = c;
+  }
+  void text(std::string_view s) {
+    for (char c : s) put(c);
+  }
   template <class T>
   void binary(T value) {
-    const char* raw = reinterpret_cast<const char*>(&value);
-    buffer_.append(raw, raw + sizeof(T));
-  }
-  void maybe_flush() {
-    if (buffer_.size() > (1u << 20)) flush();
+    make_room();
+    std::memcpy(p_, &value, sizeof(T));
+    p_ += sizeof(T);
   }
   void flush() {
-    out_.write(buffer_.data(), std::streamsize(buffer_.size()));
-    buffer_.clear();
+    out_.write(data_.get(), std::streamsize(p_ - data_.get()));
+    p_ = data_.get();
   }
 
  private:
+  static constexpr std::ptrdiff_t kBlock = 1 << 20;
+  static constexpr std::ptrdiff_t kSlack = 64;  // > the longest double (24 characters) or int64 (20)
+  void make_room() {
+    if (p_ - data_.get() >= kBlock) flush();
+  }
   std::ostream& out_;
-  fmt::memory_buffer buffer_;
+  std::unique_ptr<char[]> data_;
+  char* p_;
 };
 
 /// What a Medit writer writes: vertices, triangles, and the edges MMG must keep.
@@ -601,47 +636,48 @@ int written_edge_ref(const SurfaceMesh& mesh, EdgeHandle e) {
 
 void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostream& stream) {
   OutputBuffer out(stream);
-  auto& b = out.text();
-  fmt::format_to(fmt::appender(b), "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}\n", c.vertices.size());
+  out.text("MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n");
+  out.integer(std::int64_t(c.vertices.size()));
+  out.put('\n');
   for (auto v : c.vertices) {
     const auto& p = mesh.point(v);
-    // {} is the shortest representation that reads back to the same double.
-    fmt::format_to(fmt::appender(b), "{} {} {} {}\n", p[0], p[1], p[2], mesh.vertex_ref(v));
-    out.maybe_flush();
+    out.real(p[0]), out.put(' '), out.real(p[1]), out.put(' '), out.real(p[2]), out.put(' ');
+    out.integer(mesh.vertex_ref(v)), out.put('\n');
   }
-  fmt::format_to(fmt::appender(b), "\nTriangles\n{}\n", c.faces.size());
+  out.text("\nTriangles\n");
+  out.integer(std::int64_t(c.faces.size()));
+  out.put('\n');
   for (auto f : c.faces) {
     auto h = mesh.halfedge_handle(f);
     auto v0 = mesh.to_vertex_handle(h);
     h = mesh.next_halfedge_handle(h);
     auto v1 = mesh.to_vertex_handle(h);
     auto v2 = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-    fmt::format_to(fmt::appender(b), "{} {} {} {}\n", c.vertex_index[v0.idx()] + 1, c.vertex_index[v1.idx()] + 1,
-                   c.vertex_index[v2.idx()] + 1, mesh.region(f));
-    out.maybe_flush();
+    for (auto v : {v0, v1, v2}) out.integer(c.vertex_index[v.idx()] + 1), out.put(' ');
+    out.integer(mesh.region(f)), out.put('\n');
   }
   if (!c.edges.empty()) {
-    fmt::format_to(fmt::appender(b), "\nEdges\n{}\n", c.edges.size());
+    out.text("\nEdges\n");
+    out.integer(std::int64_t(c.edges.size()));
+    out.put('\n');
     for (auto e : c.edges) {
       auto h = mesh.halfedge_handle(e, 0);
-      fmt::format_to(fmt::appender(b), "{} {} {}\n", c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1,
-                     c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1, written_edge_ref(mesh, e));
-      out.maybe_flush();
+      out.integer(c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1), out.put(' ');
+      out.integer(c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1), out.put(' ');
+      out.integer(written_edge_ref(mesh, e)), out.put('\n');
     }
   }
   auto list = [&](const char* name, const std::vector<std::int64_t>& items) {
     if (items.empty()) return;
-    fmt::format_to(fmt::appender(b), "\n{}\n{}\n", name, items.size());
-    for (auto i : items) {
-      fmt::format_to(fmt::appender(b), "{}\n", i);
-      out.maybe_flush();
-    }
+    out.put('\n'), out.text(name), out.put('\n');
+    out.integer(std::int64_t(items.size())), out.put('\n');
+    for (auto i : items) out.integer(i), out.put('\n');
   };
   list("Ridges", c.ridges);
   list("RequiredEdges", c.required_edges);
   list("Corners", c.corners);
   list("RequiredVertices", c.required_vertices);
-  fmt::format_to(fmt::appender(b), "\nEnd\n");
+  out.text("\nEnd\n");
   out.flush();
 }
 
@@ -702,14 +738,12 @@ void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, std::ost
     w.real(p[1]);
     w.real(p[2]);
     w.integer(mesh.vertex_ref(v));
-    out.maybe_flush();
   }
   w.begin(kTriangles, is + c.faces.size() * 4 * is);
   w.count(std::int64_t(c.faces.size()));
   for (auto f : c.faces) {
     for (auto v : mesh.fv_range(f)) w.integer(c.vertex_index[v.idx()] + 1);
     w.integer(mesh.region(f));
-    out.maybe_flush();
   }
   if (!c.edges.empty()) {
     w.begin(kEdges, is + c.edges.size() * 3 * is);
@@ -719,7 +753,6 @@ void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, std::ost
       w.integer(c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1);
       w.integer(c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1);
       w.integer(written_edge_ref(mesh, e));
-      out.maybe_flush();
     }
   }
   auto list = [&](int code, const std::vector<std::int64_t>& items) {
@@ -727,7 +760,6 @@ void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, std::ost
     w.begin(code, is + items.size() * is);
     w.count(std::int64_t(items.size()));
     for (auto i : items) w.integer(i);
-    out.maybe_flush();
   };
   list(kRidges, c.ridges);
   list(kRequiredEdges, c.required_edges);
@@ -761,7 +793,7 @@ std::vector<SolField> make_fields(const std::vector<int>& types, int dimension, 
   return fields;
 }
 
-SolRead read_sol_text(const std::string& text, const fs::path& file) {
+SolRead read_sol_text(std::string_view text, const fs::path& file) {
   TextScanner in(text, file);
   SolRead result;
   int dimension = 3;
@@ -810,7 +842,7 @@ SolRead read_sol_text(const std::string& text, const fs::path& file) {
   return result;
 }
 
-SolRead read_sol_binary(const std::string& bytes, const fs::path& file) {
+SolRead read_sol_binary(std::string_view bytes, const fs::path& file) {
   BinaryScanner in(bytes, file);
   const BinaryFormat format = read_binary_header(in);
   SolRead result;
@@ -832,8 +864,8 @@ SolRead read_sol_binary(const std::string& bytes, const fs::path& file) {
       auto fields = make_fields(types, dimension, 0, [&](const std::string& w) { return in.error(types_at, w); });
       std::size_t per_vertex = 0;
       for (auto& f : fields) per_vertex += std::size_t(f.dimension);
-      if (std::uint64_t(n) > (in.size() - in.pos()) / (per_vertex * format.real_size()))
-        in.need(std::size_t(n) * per_vertex * format.real_size(), fmt::format("{} solution values", n * std::int64_t(per_vertex)));
+      in.need_records(std::uint64_t(n), per_vertex * format.real_size(),
+                      fmt::format("{} vertices of {} solution values", n, per_vertex));
       for (auto& f : fields) f.values.reserve(std::size_t(n) * std::size_t(f.dimension));
       for (std::int64_t i = 0; i < n; ++i)
         for (auto& f : fields)
@@ -853,11 +885,13 @@ int solution_type_of(int components, const fs::path& file) {
 
 }  // namespace
 
+MeshRecords parse_medit(std::string_view bytes, const fs::path& file) {
+  return extension_of(file) == ".meshb" ? read_medit_binary(bytes, file) : read_medit_text(bytes, file);
+}
+
 SurfaceMesh read_medit(const fs::path& file, const ReadOptions& options) {
-  const std::string bytes = read_file_bytes(file);
-  const bool binary = extension_of(file) == ".meshb";
-  MeshRecords records = binary ? read_medit_binary(bytes, file) : read_medit_text(bytes, file);
-  return build_mesh(std::move(records), file, options);
+  const FileBytes bytes(file);
+  return build_mesh(parse_medit(bytes.view(), file), file, options);
 }
 
 void write_medit(const SurfaceMesh& mesh, const fs::path& file, bool binary) {
@@ -880,9 +914,9 @@ std::vector<SolField> read_sol_all(const std::filesystem::path& file, std::size_
   const std::string ext = extension_of(file);
   if (ext != ".sol" && ext != ".solb")
     throw file_error(file, fmt::format("unknown solution extension '{}' (expected .sol or .solb)", ext));
-  const std::string bytes = io_detail::read_file_bytes(file);
+  const io_detail::FileBytes bytes(file);
   const bool binary = ext == ".solb";
-  auto result = binary ? io_detail::read_sol_binary(bytes, file) : io_detail::read_sol_text(bytes, file);
+  auto result = binary ? io_detail::read_sol_binary(bytes.view(), file) : io_detail::read_sol_text(bytes.view(), file);
   auto where = [&](const std::string& what) {
     return binary ? file_error(file, fmt::format("byte {}: {}", result.offset, what))
                   : file_error(file, result.line, what);
@@ -915,22 +949,22 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
   write_atomically(file, [&](std::ostream& stream) {
     io_detail::OutputBuffer out(stream);
     if (ext == ".sol") {
-      auto& b = out.text();
-      fmt::format_to(fmt::appender(b), "MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n{}\n{}", n,
-                     fields.size());
-      for (int t : types) fmt::format_to(fmt::appender(b), " {}", t);
-      b.push_back('\n');
+      out.text("MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n");
+      out.integer(std::int64_t(n)), out.put('\n');
+      out.integer(std::int64_t(fields.size()));
+      for (int t : types) out.put(' '), out.integer(t);
+      out.put('\n');
       for (std::size_t i = 0; i < n; ++i) {
-        const char* separator = "";
+        bool first = true;
         for (const auto& f : fields)
           for (int k = 0; k < f.dimension; ++k) {
-            fmt::format_to(fmt::appender(b), "{}{}", separator, f.values[i * std::size_t(f.dimension) + std::size_t(k)]);
-            separator = " ";
+            if (!first) out.put(' ');
+            out.real(f.values[i * std::size_t(f.dimension) + std::size_t(k)]);
+            first = false;
           }
-        b.push_back('\n');
-        out.maybe_flush();
+        out.put('\n');
       }
-      fmt::format_to(fmt::appender(b), "\nEnd\n");
+      out.text("\nEnd\n");
     } else {
       std::uint64_t per_vertex = 0;
       for (const auto& f : fields) per_vertex += std::uint64_t(f.dimension);
@@ -945,7 +979,6 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
       for (std::size_t i = 0; i < n; ++i) {
         for (const auto& f : fields)
           for (int k = 0; k < f.dimension; ++k) w.real(f.values[i * std::size_t(f.dimension) + std::size_t(k)]);
-        out.maybe_flush();
       }
       w.begin(io_detail::kEnd, 0);
     }
