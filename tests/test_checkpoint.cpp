@@ -1,8 +1,10 @@
 // Checkpoints: bit-exact round trips of the mesh, the run state and a model's state; corrupt and
 // truncated files refused; formats 1 and 2 still read; canonicalize() gives the mesh a checkpoint
-// reads back.
+// reads back; the cadence of `bodyfit run` (every N iterations, every S seconds, always at the end
+// and on SIGINT) and a resume after a crash between two checkpoints.
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
+#include <bodyfit/checkpoint_writer.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
@@ -13,6 +15,8 @@
 #include <doctest/doctest.h>
 
 #include <cstring>
+#include <fstream>
+#include <regex>
 #include <sstream>
 
 using namespace bodyfit;
@@ -211,4 +215,142 @@ TEST_CASE("canonicalize gives the arrays a checkpoint reads back, without the ro
   const Checkpoint read = parse(bytes_of(mesh, {}, nullptr));
   check_same_arrays(mesh, read.mesh);
   CHECK_FALSE(mesh.status(*mesh.vertices().begin()).tagged());
+}
+
+// ---- the cadence of `bodyfit run` ------------------------------------------------------------
+
+namespace {
+
+/// The iterations `bodyfit -v run` took a checkpoint of, from its debug lines.
+std::vector<int> checkpointed(const std::string& output) {
+  static const std::regex line("checkpoint of iteration ([0-9]+):");
+  std::vector<int> iterations;
+  for (std::sregex_iterator it(output.begin(), output.end(), line), end; it != end; ++it)
+    iterations.push_back(std::stoi((*it)[1]));
+  return iterations;
+}
+
+/// history.csv without its wall-clock columns (ms_*), after checking that it has one row per
+/// iteration 0..last, each exactly once and in order.
+std::string history_rows(const std::filesystem::path& file, int last) {
+  std::stringstream in(test::read_file(file)), out;
+  std::vector<bool> keep;
+  int expected = -1;
+  for (std::string line; std::getline(in, line);) {
+    std::stringstream cells(line);
+    std::size_t c = 0;
+    for (std::string cell; std::getline(cells, cell, ','); ++c) {
+      if (keep.size() <= c) keep.push_back(cell.rfind("ms_", 0) != 0);  // from the header
+      if (c == 0 && expected >= 0) CHECK(cell == std::to_string(expected));
+      if (keep[c]) out << cell << ',';
+    }
+    out << '\n';
+    ++expected;
+  }
+  CHECK(expected == last + 1);
+  return out.str();
+}
+
+struct PlaneRun {
+  test::TempDir dir{"checkpoint_cadence"};
+  std::filesystem::path case_file = dir / "case.toml";
+  PlaneRun() { std::ofstream(case_file) << kPlane << "\n[output]\nvtu_every = 0\n"; }
+  test::CommandResult run(const std::string& out, const std::string& arguments) const {
+    return test::run_bodyfit("-v run " + case_file.string() + " -o " + (dir / out).string() + " " + arguments);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("checkpoint cadence: due every N iterations, every S seconds, both off") {
+  test::TempDir dir("checkpoint_due");
+  CheckpointWriter every3(dir / "a.bin", {.every = 3, .seconds = 0});
+  std::vector<int> due;
+  for (int n = 1; n <= 10; ++n)
+    if (every3.due(n)) due.push_back(n);
+  CHECK(due == std::vector<int>{3, 6, 9});
+  CHECK(CheckpointWriter(dir / "b.bin", {.every = 0, .seconds = 1e-9}).due(1));
+  CHECK_FALSE(CheckpointWriter(dir / "c.bin", {.every = 0, .seconds = 1e9}).due(1));
+  CHECK_FALSE(CheckpointWriter(dir / "d.bin", {.every = 0, .seconds = 0}).due(1));
+}
+
+TEST_CASE("checkpoint writer: the snapshot is written in the background, one write at a time, bit-exactly") {
+  test::TempDir dir("checkpoint_writer");
+  const SurfaceMesh mesh = evolved_plane();
+  ModelState state;
+  state.version = 2;
+  state.set("x", 0.1 + 0.2);
+  CheckpointWriter writer(dir / "checkpoint.bin", {});
+  CHECK(writer.last_iteration() == -1);
+  CHECK(writer.snapshot(mesh, {.iteration = 4, .time = 0.5, .dt = 0.125}, &state) >= 0);
+  writer.start();
+  // The next snapshot waits for the write in flight, then reuses the buffer.
+  writer.snapshot(mesh, {.iteration = 5, .time = 0.625, .dt = 0.125}, &state);
+  CHECK(load_checkpoint(dir / "checkpoint.bin").run.iteration == 4);
+  writer.start();
+  writer.wait();
+  CHECK(writer.last_iteration() == 5);
+  const Checkpoint c = load_checkpoint(dir / "checkpoint.bin");
+  CHECK(c.run.iteration == 5);
+  CHECK(c.run.time == 0.625);
+  REQUIRE(c.model);
+  CHECK(*c.model == state);
+  check_same_arrays(c.mesh, mesh);
+  // The same bytes as the synchronous writer.
+  CHECK(test::read_file(dir / "checkpoint.bin") == bytes_of(mesh, c.run, &state));
+  // A failed write surfaces on the loop's next call.
+  CheckpointWriter nowhere(dir / "missing" / "checkpoint.bin", {});
+  nowhere.snapshot(mesh, {}, nullptr);
+  nowhere.start();
+  CHECK_THROWS_AS(nowhere.wait(), InputError);
+}
+
+TEST_CASE("bodyfit run: checkpoints at iterations N, 2N... and at the end; by seconds; only at the end") {
+  PlaneRun plane;
+  auto by_iterations = plane.run("every3", "--set time.iterations=7 --set output.checkpoint_every=3 "
+                                           "--set output.checkpoint_seconds=0");
+  REQUIRE_MESSAGE(by_iterations.exit_code == 0, by_iterations.output);
+  CHECK(checkpointed(by_iterations.output) == std::vector<int>{0, 3, 6, 7});
+  CHECK(load_checkpoint(plane.dir / "every3" / "checkpoint.bin").run.iteration == 7);
+
+  auto every_iteration = plane.run("tiny", "--set time.iterations=4 --set output.checkpoint_seconds=1e-9");
+  REQUIRE_MESSAGE(every_iteration.exit_code == 0, every_iteration.output);
+  CHECK(checkpointed(every_iteration.output) == std::vector<int>{0, 1, 2, 3, 4});
+
+  auto at_end = plane.run("huge", "--set time.iterations=4 --set output.checkpoint_seconds=1e9");
+  REQUIRE_MESSAGE(at_end.exit_code == 0, at_end.output);
+  CHECK(checkpointed(at_end.output) == std::vector<int>{0, 4});
+  CHECK(load_checkpoint(plane.dir / "huge" / "checkpoint.bin").run.iteration == 4);
+
+  // SIGINT between two checkpoints: the last completed iteration is checkpointed on the way out.
+  auto interrupted = plane.run("int", "--set time.iterations=6 --set output.checkpoint_seconds=1e9 "
+                                      "--inject-signal 3:INT:scheduled");
+  CHECK_MESSAGE(interrupted.exit_code == 130, interrupted.output);
+  CHECK(checkpointed(interrupted.output) == std::vector<int>{0, 3});
+  CHECK(load_checkpoint(plane.dir / "int" / "checkpoint.bin").run.iteration == 3);
+
+  auto bad = plane.run("bad", "--set output.checkpoint_every=-1");
+  CHECK(bad.exit_code != 0);
+  CHECK(bad.output.find("checkpoint_every") != std::string::npos);
+}
+
+TEST_CASE("a kill between two checkpoints, then --resume: the same final mesh, every history row once") {
+  PlaneRun plane;
+  const std::string common =
+      "--set time.iterations=8 --set output.checkpoint_every=3 --set output.checkpoint_seconds=0";
+  auto full = plane.run("full", common);
+  REQUIRE_MESSAGE(full.exit_code == 0, full.output);
+
+  auto killed = plane.run("part", common + " --inject-signal 5:KILL:scheduled");
+  CHECK_MESSAGE(killed.exit_code == 128 + 9, killed.output);
+  CHECK(load_checkpoint(plane.dir / "part" / "checkpoint.bin").run.iteration == 3);
+  history_rows(plane.dir / "part" / "history.csv", 5);  // rows 4 and 5 are past the checkpoint
+
+  auto resumed = plane.run("part", common + " --resume");
+  REQUIRE_MESSAGE(resumed.exit_code == 0, resumed.output);
+  CHECK(resumed.output.find("resuming from iteration 3") != std::string::npos);
+  CHECK(checkpointed(resumed.output) == std::vector<int>{6, 8});
+  CHECK(test::read_file(plane.dir / "part" / "final.mesh") == test::read_file(plane.dir / "full" / "final.mesh"));
+  CHECK(test::read_file(plane.dir / "part" / "final.sol") == test::read_file(plane.dir / "full" / "final.sol"));
+  CHECK(history_rows(plane.dir / "part" / "history.csv", 8) == history_rows(plane.dir / "full" / "history.csv", 8));
 }

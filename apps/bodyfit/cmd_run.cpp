@@ -3,6 +3,7 @@
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/case_config.hpp>
+#include <bodyfit/checkpoint_writer.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/history.hpp>
@@ -32,28 +33,36 @@ struct RunArguments {
   std::string output_dir;
   std::vector<std::string> sets;
   bool resume = false;
-  std::string inject_signal;  ///< "N:INT" or "N:KILL": raise the signal after iteration N's checkpoint (tests)
+  std::string inject_signal;  ///< "N:INT" or "N:KILL" [":scheduled"]: raise a signal after iteration N (tests)
 };
 
-/// The test hook of --inject-signal: the iteration and the signal it raises once that iteration
-/// is checkpointed (SIGINT exercises the clean stop, SIGKILL a crash between two iterations).
+/// The test hook of --inject-signal: the iteration and the signal it raises once that iteration's
+/// history row and checkpoint are written (SIGINT exercises the clean stop, SIGKILL a crash
+/// between two iterations). With ":scheduled" iteration N gets a checkpoint only if the cadence
+/// asks for one (a crash between two checkpoints); the write in flight, if any, completes first.
 struct InjectedSignal {
   int iteration = -1;
   int signal = 0;
+  bool force_checkpoint = true;
 };
 InjectedSignal parse_injected_signal(const std::string& text) {
   if (text.empty()) return {};
-  const auto colon = text.find(':');
-  const std::string what = colon == std::string::npos ? "" : text.substr(colon + 1);
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  for (std::string part; std::getline(in, part, ':');) parts.push_back(part);
   InjectedSignal s;
   try {
-    s.iteration = std::stoi(text.substr(0, colon));
+    if (parts.size() >= 2) s.iteration = std::stoi(parts[0]);
   } catch (const std::exception&) {
     s.iteration = -1;
   }
-  s.signal = what == "INT" ? SIGINT : what == "KILL" ? SIGKILL : 0;
+  if (parts.size() >= 2) s.signal = parts[1] == "INT" ? SIGINT : parts[1] == "KILL" ? SIGKILL : 0;
+  if (parts.size() == 3 && parts[2] == "scheduled") s.force_checkpoint = false;
+  else if (parts.size() != 2) s.signal = 0;
   if (s.iteration < 0 || s.signal == 0)
-    throw InputError(fmt::format("--inject-signal {}: expected ITERATION:INT or ITERATION:KILL", text));
+    throw InputError(fmt::format("--inject-signal {}: expected ITERATION:INT or ITERATION:KILL, optionally followed "
+                                 "by :scheduled",
+                                 text));
   return s;
 }
 
@@ -97,9 +106,17 @@ int run_case(const RunArguments& args) {
   options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
 
   const fs::path checkpoint = outdir / "checkpoint.bin";
+  const auto& out = config.output;
+  // Checkpoints as the cadence asks, written in the background; the one of the last completed
+  // iteration is always written at the end (an interruption included).
+  CheckpointWriter checkpoints(checkpoint, {.every = out.checkpoint_every, .seconds = out.checkpoint_seconds});
   RunHistory history(outdir / "history.csv");
   std::unique_ptr<PvdWriter> pvd;
   RunState start;
+  // The model's state after the last completed iteration, saved at every iteration as before the
+  // cadence (computing the final state's fields changes it), so that the end-of-run checkpoint is
+  // exactly the one the iteration's hook would have written.
+  ModelState model_state;
   if (args.resume) {
     if (!fs::exists(checkpoint))
       throw InputError(fmt::format("--resume: no checkpoint in {} (run without --resume first)", outdir.string()));
@@ -108,11 +125,13 @@ int run_case(const RunArguments& args) {
     start = c.run;
     if (c.model) {
       model->load_state(*c.model);
+      model_state = *c.model;
     } else {
       spdlog::warn("{}: format {} checkpoint without model state: model '{}' starts afresh (results may differ "
                    "from an uninterrupted run)",
                    checkpoint.string(), c.format, model->name());
     }
+    checkpoints.assume_written(c.run.iteration);
     if (!history.resume(c.run.iteration)) {
       if (c.run.iteration == 0) history.add(measure_state(mesh, 0, 0));  // killed before row 0 was written
       else spdlog::warn("{}: rows missing before iteration {}", (outdir / "history.csv").string(), c.run.iteration);
@@ -121,14 +140,13 @@ int run_case(const RunArguments& args) {
     spdlog::info("resuming from iteration {} (t = {})", c.run.iteration, c.run.time);
   } else {
     pvd = std::make_unique<PvdWriter>(outdir / "series.pvd");
-    ModelState state;
-    model->save_state(state);
-    save_checkpoint(checkpoint, mesh, start, &state);
+    model->save_state(model_state);
+    checkpoints.snapshot(mesh, start, &model_state);
+    checkpoints.start();
     history.add(measure_state(mesh, 0, 0));
   }
   spdlog::info("h = {:.4g}, dt = {:.4g}, final time {}, {} faces", h, options.dt, options.final_time, mesh.n_faces());
 
-  const auto& out = config.output;
   EvolutionHooks hooks;
   hooks.stop = &g_interrupted;
   hooks.on_state = [&](const StateView& s) {
@@ -155,12 +173,24 @@ int run_case(const RunArguments& args) {
     }
   };
   const InjectedSignal inject = parse_injected_signal(args.inject_signal);
+  RunState last_run = start;
   hooks.on_iteration = [&](const SurfaceMesh& m, const IterationRecord& r, const RunState& run) {
-    history.add(r);
-    ModelState state;
-    model->save_state(state);
-    save_checkpoint(checkpoint, m, run, &state);
-    if (r.iteration == inject.iteration) std::raise(inject.signal);
+    last_run = run;
+    model_state = ModelState();
+    model->save_state(model_state);
+    const bool injected = r.iteration == inject.iteration;
+    const bool due = checkpoints.due(r.iteration) || g_interrupted.load() || (injected && inject.force_checkpoint);
+    // The loop's share of the checkpoint (waiting for the previous write, copying the state)
+    // belongs to this row's ms_output; the evolution adds the hook's time only after the row
+    // is written. The row goes to disk before the checkpoint, so that a resume finds its rows.
+    IterationRecord row = r;
+    if (due) row.ms.output += checkpoints.snapshot(m, run, &model_state);
+    history.add(row);
+    if (due) checkpoints.start();
+    if (injected) {
+      checkpoints.wait();
+      std::raise(inject.signal);
+    }
   };
 
   // An exception thrown in the plugin may carry a vtable of the plugin's own, which is unloaded
@@ -176,6 +206,11 @@ int run_case(const RunArguments& args) {
     throw std::runtime_error(fmt::format("model '{}' threw an exception that is not a std::exception", model->name()));
   }
   if (history.rows() == 1) history.flush();
+  if (checkpoints.last_iteration() != last_run.iteration) {
+    checkpoints.snapshot(mesh, last_run, &model_state);
+    checkpoints.start();
+  }
+  checkpoints.wait();
 
   if (result.reason == StopReason::Interrupted) {
     spdlog::warn("interrupted: iteration {} (t = {}) is complete and saved; continue with --resume", result.iteration,

@@ -233,6 +233,8 @@ void parse_output(const toml::table& table, OutputSpec& out) {
   out.view = p.choice("view", out.view, {"iso", "top", "front"});
   if (auto size = p.numbers("size", {}, 2, {.min = 16, .max = 8192}); !size.empty())
     out.width = int(size[0]), out.height = int(size[1]);
+  out.checkpoint_every = clamp_to_int(p.integer("checkpoint_every", out.checkpoint_every, 0));
+  out.checkpoint_seconds = p.number("checkpoint_seconds", out.checkpoint_seconds, {.min = 0});
   p.reject_unknown();
 }
 

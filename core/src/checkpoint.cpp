@@ -6,10 +6,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <stdexcept>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace bodyfit {
 namespace {
@@ -26,24 +30,28 @@ constexpr char kMagicV3[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '3'};
 // halfedge; an edge 2 × (vertex, next, face) + ref + 3 flags; a face its halfedge + region.
 constexpr std::uint64_t kVertexBytes = 42, kEdgeBytes = 31, kFaceBytes = 8;
 
-/// Checkpoint bytes, built in memory and written at once.
-class Bytes {
+/// Checkpoint bytes written through a cursor into a buffer sized beforehand: the snapshot is one
+/// sequential pass of fixed-size copies, with no growth or bounds check per value.
+class Writer {
  public:
+  explicit Writer(char* at) : at_(at) {}
   template <class T>
   void put(const T& value) {
-    data_.append(reinterpret_cast<const char*>(&value), sizeof(T));
+    std::memcpy(at_, &value, sizeof(T));
+    at_ += sizeof(T);
   }
-  void put_raw(const char* bytes, std::size_t size) { data_.append(bytes, size); }
+  void put_raw(const void* bytes, std::size_t size) {
+    if (size) std::memcpy(at_, bytes, size);
+    at_ += size;
+  }
   void put_string(const std::string& s) {
     put<std::uint64_t>(s.size());
-    data_.append(s);
+    put_raw(s.data(), s.size());
   }
-  void reserve(std::size_t size) { data_.reserve(size); }
-  const std::string& data() const { return data_; }
-  std::string& data() { return data_; }
+  const char* at() const { return at_; }
 
  private:
-  std::string data_;
+  char* at_;
 };
 
 /// Reading checkpoint bytes: every read is bounds-checked ("truncated checkpoint").
@@ -84,7 +92,7 @@ class Cursor {
   std::size_t at_ = 0;
 };
 
-void put_vertex(Bytes& out, const SurfaceMesh& mesh, VertexHandle v) {
+void put_vertex(Writer& out, const SurfaceMesh& mesh, VertexHandle v) {
   const Vec3& p = mesh.point(v);
   out.put(p[0]), out.put(p[1]), out.put(p[2]);
   out.put<std::int32_t>(mesh.vertex_ref(v));
@@ -103,7 +111,7 @@ void get_vertex(Cursor& in, SurfaceMesh& mesh, VertexHandle v) {
   mesh.phi(v) = in.get<double>();
 }
 
-void put_edge_tags(Bytes& out, const SurfaceMesh& mesh, EdgeHandle e) {
+void put_edge_tags(Writer& out, const SurfaceMesh& mesh, EdgeHandle e) {
   out.put<std::int32_t>(mesh.edge_ref(e));
   out.put<char>(mesh.interface(e));
   out.put<char>(mesh.ridge(e));
@@ -219,7 +227,20 @@ std::uint64_t checksum(const char* data, std::size_t size) {
 
 enum class EntryType : std::uint8_t { Numbers = 0, Integers = 1, Bytes = 2 };
 
-void put_model_state(Bytes& out, const ModelState& state) {
+/// The size of what put_model_state writes.
+std::size_t model_state_size(const ModelState& state) {
+  std::size_t size = 4 + 8;
+  for (const auto& [key, value] : state.values()) {
+    size += 8 + key.size() + 1;
+    if (const auto* numbers = std::get_if<std::vector<double>>(&value)) size += 8 + numbers->size() * sizeof(double);
+    else if (const auto* integers = std::get_if<std::vector<std::int64_t>>(&value))
+      size += 8 + integers->size() * sizeof(std::int64_t);
+    else size += 8 + std::get<std::string>(value).size();
+  }
+  return size;
+}
+
+void put_model_state(Writer& out, const ModelState& state) {
   out.put<std::uint32_t>(state.version);
   out.put<std::uint64_t>(state.values().size());
   for (const auto& [key, value] : state.values()) {
@@ -265,38 +286,18 @@ ModelState get_model_state(Cursor& in) {
   return state;
 }
 
-std::string encode_checkpoint(const SurfaceMesh& mesh, const RunState& run, const ModelState* model) {
-  if (has_deleted(mesh)) throw std::logic_error("write_checkpoint: the mesh must be garbage-collected");
-  Bytes out;
-  out.reserve(80 + kVertexBytes * mesh.n_vertices() + kEdgeBytes * mesh.n_edges() + kFaceBytes * mesh.n_faces());
-  out.put_raw(kMagicV3, sizeof kMagicV3);
-  out.put<std::int64_t>(run.iteration);
-  out.put<double>(run.time);
-  out.put<double>(run.dt);
-  out.put<std::uint64_t>(mesh.n_vertices());
-  out.put<std::uint64_t>(mesh.n_edges());
-  out.put<std::uint64_t>(mesh.n_faces());
-  for (auto v : mesh.vertices()) {
-    put_vertex(out, mesh, v);
-    out.put<std::int32_t>(mesh.halfedge_handle(v).idx());
+/// Fsync a file or directory so that a power loss after the rename keeps it (best effort for the
+/// directory: some file systems refuse to sync one).
+void sync_path(const std::filesystem::path& path, bool directory) {
+  const int fd = ::open(path.c_str(), O_RDONLY | (directory ? O_DIRECTORY : 0));
+  if (fd < 0) {
+    if (directory) return;
+    throw file_error(path, fmt::format("cannot open to sync ({})", std::strerror(errno)));
   }
-  for (auto e : mesh.edges()) {
-    for (int side = 0; side < 2; ++side) {
-      const auto h = mesh.halfedge_handle(e, side);
-      out.put<std::int32_t>(mesh.to_vertex_handle(h).idx());
-      out.put<std::int32_t>(mesh.next_halfedge_handle(h).idx());
-      out.put<std::int32_t>(mesh.face_handle(h).idx());
-    }
-    put_edge_tags(out, mesh, e);
-  }
-  for (auto f : mesh.faces()) {
-    out.put<std::int32_t>(mesh.halfedge_handle(f).idx());
-    out.put<std::int32_t>(mesh.region(f));
-  }
-  out.put<std::uint8_t>(model ? 1 : 0);
-  if (model) put_model_state(out, *model);
-  out.put<std::uint64_t>(checksum(out.data().data(), out.data().size()));
-  return std::move(out.data());
+  const int failed = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (failed && !directory) throw file_error(path, fmt::format("fsync failed ({})", std::strerror(error)));
 }
 
 Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
@@ -332,9 +333,72 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
 
 }  // namespace
 
+void CheckpointSnapshot::seal() {
+  if (size_ < 8) return;
+  const std::uint64_t sum = checksum(data_.get(), size_ - 8);
+  std::memcpy(data_.get() + size_ - 8, &sum, 8);
+}
+
+void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model) {
+  if (has_deleted(mesh)) throw std::logic_error("take_snapshot: the mesh must be garbage-collected");
+  const std::size_t nv = mesh.n_vertices(), ne = mesh.n_edges(), nf = mesh.n_faces();
+  const std::size_t size = 56 + kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf + 1 +
+                           (model ? model_state_size(*model) : 0) + 8;
+  if (into.capacity_ < size) {
+    into.data_.reset();  // free the old buffer before taking the larger one
+    into.data_ = std::make_unique_for_overwrite<char[]>(size);
+    into.capacity_ = size;
+  }
+  into.size_ = size;
+  into.iteration_ = run.iteration;
+  Writer out(into.data_.get());
+  out.put_raw(kMagicV3, sizeof kMagicV3);
+  out.put<std::int64_t>(run.iteration);
+  out.put<double>(run.time);
+  out.put<double>(run.dt);
+  out.put<std::uint64_t>(nv);
+  out.put<std::uint64_t>(ne);
+  out.put<std::uint64_t>(nf);
+  // By index: the mesh has no deleted element, so indices are the iteration order.
+  for (std::size_t i = 0; i < nv; ++i) {
+    const VertexHandle v{int(i)};
+    put_vertex(out, mesh, v);
+    out.put<std::int32_t>(mesh.halfedge_handle(v).idx());
+  }
+  for (std::size_t i = 0; i < ne; ++i) {
+    for (int side = 0; side < 2; ++side) {
+      const HalfedgeHandle h{int(2 * i) + side};
+      out.put<std::int32_t>(mesh.to_vertex_handle(h).idx());
+      out.put<std::int32_t>(mesh.next_halfedge_handle(h).idx());
+      out.put<std::int32_t>(mesh.face_handle(h).idx());
+    }
+    put_edge_tags(out, mesh, EdgeHandle(int(i)));
+  }
+  for (std::size_t i = 0; i < nf; ++i) {
+    const FaceHandle f{int(i)};
+    out.put<std::int32_t>(mesh.halfedge_handle(f).idx());
+    out.put<std::int32_t>(mesh.region(f));
+  }
+  out.put<std::uint8_t>(model ? 1 : 0);
+  if (model) put_model_state(out, *model);
+  out.put<std::uint64_t>(0);  // the checksum, filled in by seal()
+  if (out.at() != into.data_.get() + size) throw std::logic_error("take_snapshot: size mismatch");
+}
+
+void save_checkpoint(const std::filesystem::path& file, CheckpointSnapshot& snapshot) {
+  snapshot.seal();
+  const std::string_view bytes = snapshot.bytes();
+  write_atomically(file, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); });
+  // After the rename (write_atomically owns the temporary): the new file, then its directory entry.
+  sync_path(file, false);
+  sync_path(file.has_parent_path() ? file.parent_path() : std::filesystem::path("."), true);
+}
+
 void write_checkpoint(std::ostream& out, const SurfaceMesh& mesh, const RunState& run, const ModelState* model) {
-  const std::string data = encode_checkpoint(mesh, run, model);
-  out.write(data.data(), std::streamsize(data.size()));
+  CheckpointSnapshot snapshot;
+  take_snapshot(snapshot, mesh, run, model);
+  snapshot.seal();
+  out.write(snapshot.bytes().data(), std::streamsize(snapshot.bytes().size()));
 }
 
 Checkpoint read_checkpoint(std::istream& in, const std::string& name) {
@@ -344,7 +408,9 @@ Checkpoint read_checkpoint(std::istream& in, const std::string& name) {
 
 void save_checkpoint(const std::filesystem::path& file, const SurfaceMesh& mesh, const RunState& run,
                      const ModelState* model) {
-  write_atomically(file, [&](std::ostream& out) { write_checkpoint(out, mesh, run, model); });
+  CheckpointSnapshot snapshot;
+  take_snapshot(snapshot, mesh, run, model);
+  save_checkpoint(file, snapshot);
 }
 
 Checkpoint load_checkpoint(const std::filesystem::path& file) {

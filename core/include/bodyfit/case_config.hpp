@@ -9,7 +9,7 @@
 //   [model]      name = "conormal", every other key is the model's own parameter
 //   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, narrow_band, max_rejections
 //   [distance] [advection] [discretize] [remesh]   options of each stage
-//   [output]     vtu_every, png_every, field, view, size = [w, h]
+//   [output]     vtu_every, png_every, field, view, size = [w, h], checkpoint_every, checkpoint_seconds
 //
 // Every table and key is checked (with bodyfit::Parameters): an unknown one is an InputError with a
 // suggestion ("case.toml:9: unknown key 'final_tiem' in [time]; did you mean 'final_time'?"), as is
@@ -79,6 +79,10 @@ struct OutputSpec {
   std::string field = "region";   ///< region | phi | d | quality | height | a model's point field
   std::string view = "iso";       ///< iso | top | front
   int width = 800, height = 600;
+  /// The checkpoint's cadence (0 turns a criterion off); a run always checkpoints at its start,
+  /// its end and on SIGINT (docs/running.md).
+  int checkpoint_every = 0;         ///< iterations
+  double checkpoint_seconds = 30;   ///< wall-clock seconds since the last checkpoint
 };
 
 struct CaseConfig {

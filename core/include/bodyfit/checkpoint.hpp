@@ -12,8 +12,10 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace bodyfit {
 
@@ -30,6 +32,30 @@ struct Checkpoint {
   std::optional<ModelState> model;  ///< absent in formats 1 and 2
   int format = 3;                   ///< the format the file was written in
 };
+
+/// A checkpoint taken out of a live run: the arrays, the run state and the model state encoded in
+/// memory, so that the file can be written while the run goes on (checkpoint_writer.hpp). Taking a
+/// snapshot into the same object again reuses its memory: a run allocates it once.
+class CheckpointSnapshot {
+ public:
+  int iteration() const { return iteration_; }
+  /// The bytes of the file (the checksum is filled in by seal()).
+  std::string_view bytes() const { return {data_.get(), size_}; }
+  /// Compute the checksum over the rest (the slow part after the copy: done by the writer).
+  void seal();
+
+ private:
+  friend void take_snapshot(CheckpointSnapshot&, const SurfaceMesh&, const RunState&, const ModelState*);
+  std::unique_ptr<char[]> data_;
+  std::size_t size_ = 0, capacity_ = 0;
+  int iteration_ = -1;
+};
+
+/// Copy the state into `into` (one sequential pass over the arrays). The mesh must be
+/// garbage-collected; `model` may be null (no model state stored).
+void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model);
+/// Seal and write a snapshot atomically (temporary + rename), then fsync it and its directory.
+void save_checkpoint(const std::filesystem::path& file, CheckpointSnapshot& snapshot);
 
 /// The mesh must be garbage-collected. `model` may be null (no model state stored).
 void write_checkpoint(std::ostream& out, const SurfaceMesh& mesh, const RunState& run, const ModelState* model = nullptr);
