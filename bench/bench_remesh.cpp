@@ -7,6 +7,8 @@
 // remesher projects onto the input triangles. Then one evolution step: the cap grows by about one
 // element (β − (π/4 + h)), discretize + remesh of the already-remeshed mesh; its cost is compared
 // with the full first remeshing.
+#include "bench_args.hpp"
+
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>
@@ -117,15 +119,17 @@ int main(int argc, char** argv) {
   bool quick = false, terrain = true;
   std::string csv = "bench_remesh.csv";
   std::vector<std::size_t> sizes;
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    if (a == "--quick") quick = true;
-    else if (a == "--no-terrain") terrain = false;
-    else if (a == "--spheres" && i + 1 < argc) {
-      std::stringstream list(argv[++i]);
-      for (std::string item; std::getline(list, item, ',');) sizes.push_back(std::stoul(item));
-    } else csv = a;
-  }
+  bench::Arguments args("bench_remesh",
+                        "usage: bench_remesh [--quick] [--spheres 9700,242000] [--no-terrain] [out.csv]\n"
+                        "  --quick       the 9.7k sphere only\n"
+                        "  --spheres     sphere sizes in faces (0: none; default 9700,60000,242000)\n"
+                        "  --no-terrain  skip the terrain case\n"
+                        "  out.csv       default bench_remesh.csv\n");
+  args.flag("--quick", quick);
+  args.flag("--no-terrain", [&] { terrain = false; });
+  args.option("--spheres", sizes);
+  args.positional("out.csv", csv);
+  args.parse(argc, argv);
   std::vector<Row> rows;
   if (sizes.empty()) sizes = quick ? std::vector<std::size_t>{9700} : std::vector<std::size_t>{9700, 60000, 242000};
 
