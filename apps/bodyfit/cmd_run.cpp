@@ -201,9 +201,9 @@ int run_case(const RunArguments& args) {
   } catch (const InputError& e) {
     throw InputError(e.what());
   } catch (const std::exception& e) {
-    throw std::runtime_error(fmt::format("model '{}': {}", model->name(), e.what()));
+    throw PluginError(fmt::format("model '{}': {}", model->name(), e.what()));
   } catch (...) {
-    throw std::runtime_error(fmt::format("model '{}' threw an exception that is not a std::exception", model->name()));
+    throw PluginError(fmt::format("model '{}' threw an exception that is not a std::exception", model->name()));
   }
   if (history.rows() == 1) history.flush();
   if (checkpoints.last_iteration() != last_run.iteration) {

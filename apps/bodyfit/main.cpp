@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
     app.parse(arguments);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);  // prints help, version or the error
-    return code == 0 ? 0 : 2;      // a usage error is exit code 2, not CLI11's 105-114
+    return code == 0 ? 0 : int(ExitCode::Usage);  // not CLI11's raw 105-114
   }
 
   // oneTBB's limit for the whole process, the plugins' parallel loops included.
@@ -93,12 +93,11 @@ int main(int argc, char** argv) {
     for (auto& command : added)
       if (command.app->parsed()) return command.run();
     spdlog::error("no subcommand given (see --help)");
-    return 2;
-  } catch (const InputError& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+    return int(ExitCode::Usage);
   } catch (const std::exception& e) {
-    spdlog::error("internal error: {}", e.what());
-    return 3;
+    const ExitCode code = exit_code_of(e);
+    if (code == ExitCode::Internal) spdlog::error("internal error: {}", e.what());
+    else spdlog::error("{}", e.what());
+    return int(code);
   }
 }

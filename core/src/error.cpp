@@ -4,6 +4,14 @@
 
 namespace bodyfit {
 
+ExitCode exit_code_of(const std::exception& e) {
+  if (dynamic_cast<const InputError*>(&e)) return ExitCode::Input;
+  if (dynamic_cast<const PluginError*>(&e)) return ExitCode::Plugin;
+  if (dynamic_cast<const NumericalError*>(&e)) return ExitCode::Numerical;
+  if (dynamic_cast<const IoError*>(&e)) return ExitCode::Io;
+  return ExitCode::Internal;
+}
+
 InputError file_error(const std::filesystem::path& file, long line, const std::string& what) {
   return InputError(fmt::format("{}:{}: {}", file.string(), line, what));
 }
