@@ -51,11 +51,11 @@ void print(const Row& r) {
   std::printf(
       "%-22s in %7zu out %7zu | discretize %8.1f ms remesh %8.1f ms total %8.1f ms | q min %.3f mean %.3f "
       "<0.3 %.4f | iface err %.2e (%zu v) | hausdorff %.2e | chi %ld loops %zu | %s | splits %zu collapses %zu "
-      "flips %zu moves %zu passes %d\n",
+      "flips %zu moves %zu split rounds %d passes %d (%s)\n",
       r.name.c_str(), r.input_faces, r.output_faces, r.discretize_ms, r.remesh_ms, r.discretize_ms + r.remesh_ms,
       r.quality.min, r.quality.mean, r.quality.share_below_0_3, r.interface_error, r.interface_vertices, r.hausdorff,
       r.euler, r.loops, r.valid ? "valid" : "INVALID", r.report.splits, r.report.collapses, r.report.flips,
-      r.report.relocations, r.report.passes);
+      r.report.relocations, r.report.split_rounds, r.report.passes, to_string(r.report.stop));
   std::fflush(stdout);
 }
 
@@ -199,13 +199,14 @@ int main(int argc, char** argv) {
 
   std::ofstream out(csv);
   out << "case,input_faces,output_faces,discretize_ms,remesh_ms,total_ms,q_min,q_mean,share_below_0_3,"
-         "interface_error,hausdorff,euler,boundary_loops,valid,splits,collapses,flips,relocations,passes\n";
+         "interface_error,hausdorff,euler,boundary_loops,valid,splits,collapses,flips,relocations,passes,split_rounds,stop\n";
   for (const auto& r : rows)
     out << r.name << ',' << r.input_faces << ',' << r.output_faces << ',' << r.discretize_ms << ',' << r.remesh_ms << ','
         << r.discretize_ms + r.remesh_ms << ',' << r.quality.min << ',' << r.quality.mean << ','
         << r.quality.share_below_0_3 << ',' << r.interface_error << ',' << r.hausdorff << ',' << r.euler << ','
         << r.loops << ',' << (r.valid ? 1 : 0) << ',' << r.report.splits << ',' << r.report.collapses << ','
-        << r.report.flips << ',' << r.report.relocations << ',' << r.report.passes << '\n';
+        << r.report.flips << ',' << r.report.relocations << ',' << r.report.passes << ','
+        << r.report.split_rounds << ',' << to_string(r.report.stop) << '\n';
   std::printf("wrote %s\n", csv.c_str());
   return 0;
 }

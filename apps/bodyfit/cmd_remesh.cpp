@@ -22,7 +22,10 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
   cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", *output, "output mesh (.mesh keeps refs, readable by MMG)")->required();
   bodyfit::cli::add_remesh_options(*cmd, *options);
-  cmd->add_option("--passes", options->max_passes, "maximum split/collapse/flip/relocate passes")->capture_default_str();
+  cmd->add_option("--passes", options->max_passes,
+                  "cap on the collapse/flip/relocate passes (0: none; they stop when done or when they stop making "
+                  "progress)")
+      ->capture_default_str();
   cmd->add_flag("--full", [options](std::int64_t) { options->incremental = false; },
                 "work on every vertex, not only where the mesh needs change");
   return {cmd, [=]() {
@@ -35,9 +38,10 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
             double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             spdlog::info("remesh: {} -> {} faces, quality min {:.3f} mean {:.3f} (before {:.3f} / {:.3f})", faces_before,
                          mesh.n_faces(), report.min_quality, report.mean_quality, before.min, before.mean);
-            spdlog::info("remesh: {} splits, {} collapses, {} flips, {} relocations in {} passes; {:.1f} ms remesh, "
-                         "{:.1f} ms total -> {}",
-                         report.splits, report.collapses, report.flips, report.relocations, report.passes,
+            spdlog::info("remesh: {} splits, {} collapses, {} flips, {} relocations in {} split rounds + {} passes ({}); "
+                         "longest edge {:.3f} × its target, {} above the split bound; {:.1f} ms remesh, {:.1f} ms total -> {}",
+                         report.splits, report.collapses, report.flips, report.relocations, report.split_rounds,
+                         report.passes, bodyfit::to_string(report.stop), report.max_edge_ratio, report.long_edges,
                          report.milliseconds, total, *output);
             return 0;
           }};

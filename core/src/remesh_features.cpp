@@ -14,13 +14,9 @@ void Remesher::setup_sizes() {
 }
 
 void Remesher::classify_features() {
-  // Per-face normal and quality, once (every sweep below is parallel and writes only its own element).
-  const int nf = int(m_.n_faces()), ne = int(m_.n_edges()), nv = int(m_.n_vertices());
-  std::vector<Tri> face_tri(nf);
-  tbb::parallel_for(0, nf, [&](int i) {
-    auto p = face_points(m_, FaceHandle(i));
-    face_tri[i] = triangle(p[0], p[1], p[2]);
-  });
+  // Every sweep below is parallel and writes only its own element. (The faces' triangles are
+  // recomputed per edge rather than stored: an array of them was the largest allocation of a remesh.)
+  const int ne = int(m_.n_edges()), nv = int(m_.n_vertices());
   // Ridges by dihedral angle, added to the ridges read from the file; then the curve kind of edges.
   // A ridge of the mesh must be a crease of S too: S's normals at the two faces differ as much. The
   // evolving mesh has sharp dihedral angles where S has none (a triangle standing across a curved
@@ -30,18 +26,29 @@ void Remesher::classify_features() {
   const bool detect = opt_.feature_angle > 0;
   const double cos_limit = std::cos(opt_.feature_angle * M_PI / 180.0);
   auto s_normal = [&](FaceHandle f) {
-    auto p = face_points(m_, f);
+    auto p = points(f);
     return ref_->closest((p[0] + p[1] + p[2]) / 3.0).normal;
   };
   tbb::parallel_for(0, ne, [&](int i) {
     EdgeHandle e(i);
     if (detect && !m_.is_boundary(e) && !m_.ridge(e)) {
-      auto f0 = m_.face_handle(m_.halfedge_handle(e, 0)), f1 = m_.face_handle(m_.halfedge_handle(e, 1));
-      const auto& t0 = face_tri[f0.idx()];
-      const auto& t1 = face_tri[f1.idx()];
-      // Slivers (e.g. fresh from discretize) have unreliable normals: no ridge from them.
-      if (t0.quality >= 1e-3 && t1.quality >= 1e-3 && (t0.normal | t1.normal) < cos_limit &&
-          (s_normal(f0) | s_normal(f1)) < cos_limit)
+      // The faces (a, b, c) and (b, a, d) on either side of a→b, from their four points (this sweep
+      // runs over every edge at every remesh: no normalisation unless needed).
+      const auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+      const Vec3& a = m_.point(m_.from_vertex_handle(h0));
+      const Vec3& b = m_.point(m_.to_vertex_handle(h0));
+      const Vec3& c = m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(h0)));
+      const Vec3& d = m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(h1)));
+      const Vec3 n0 = (b - a) % (c - a), n1 = (a - b) % (d - b);
+      const double ab2 = (b - a).sqrnorm();
+      const double l0 = ab2 + (c - b).sqrnorm() + (a - c).sqrnorm(), l1 = ab2 + (d - a).sqrnorm() + (b - d).sqrnorm();
+      // Slivers (e.g. fresh from discretize) have unreliable normals: no ridge from them (quality
+      // 2√3·|n|/Σl² below 1e-3).
+      constexpr double kSliver = 1e-3 / (2 * 1.7320508075688772);
+      const double m0 = n0.sqrnorm(), m1 = n1.sqrnorm();
+      if (m0 >= kSliver * kSliver * l0 * l0 && m1 >= kSliver * kSliver * l1 * l1 &&
+          (n0 | n1) < cos_limit * std::sqrt(m0 * m1) &&
+          (s_normal(m_.face_handle(h0)) | s_normal(m_.face_handle(h1))) < cos_limit)
         m_.ridge(e) = 1;
     }
     char c = kNoCurve;
@@ -61,7 +68,7 @@ void Remesher::classify_features() {
     } else {
       // Area-weighted face normals (the quality-weighted cross products are proportional to areas).
       for (auto f : m_.vf_range(v)) {
-        auto p = face_points(m_, f);
+        auto p = points(f);
         normal += (p[1] - p[0]) % (p[2] - p[0]);
         if (!opt_.reference) hint = f.idx();
       }
@@ -75,8 +82,14 @@ void Remesher::classify_features() {
   // (a no-op when S is the input mesh itself). Where the chords sag far from S (a steep terrain at
   // hmax = 400 m: up to 130 m) that move can fold a thin triangle next to the cut; such a point
   // stays where it is, within the sag of S.
+  // (The feature edges are few: found in parallel, then visited in index order.)
+  const auto features = collect<EdgeHandle>(ne, [&](int i, EdgeHandle& e) {
+    e = EdgeHandle(i);
+    const char c = m_.property(ecurve_, e);
+    return c != kNoCurve && c != kRequiredCurve;
+  });
   if (opt_.reference)
-    for (auto e : m_.edges())
+    for (auto e : features)
       if (m_.property(ecurve_, e) == kInterfaceCurve)
         for (auto v : {m_.from_vertex_handle(m_.halfedge_handle(e, 0)), m_.to_vertex_handle(m_.halfedge_handle(e, 0))})
           if (!m_.required(v) && !m_.corner(v)) {
@@ -86,12 +99,9 @@ void Remesher::classify_features() {
             m_.set_point(v, sp.point);
             m_.property(hint_, v) = sp.face;
           }
-  for (auto e : m_.edges()) {
-    char c = m_.property(ecurve_, e);
-    if (c != kNoCurve && c != kRequiredCurve) {
-      auto h = m_.halfedge_handle(e, 0);
-      curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), c);
-    }
+  for (auto e : features) {
+    auto h = m_.halfedge_handle(e, 0);
+    curves_.add(m_.point(m_.from_vertex_handle(h)), m_.point(m_.to_vertex_handle(h)), m_.property(ecurve_, e));
   }
   // The interface samples a smooth curve: split midpoints and relocated vertices go onto a C¹ curve
   // through its vertices, not onto its chords (which would shrink convex regions at every remesh).

@@ -16,8 +16,9 @@ bool Remesher::split(EdgeHandle e) {
   // The two (or one) opposite vertices and their face regions; the new point must not fold them.
   VertexHandle opposite[2];
   int region[2] = {0, 0};
-  std::vector<FaceHandle> replaced;
-  std::vector<std::array<VertexHandle, 3>> after;  // the new vertex is the invalid handle, at p
+  std::array<FaceHandle, 2> replaced;
+  std::array<std::array<VertexHandle, 3>, 4> after;  // the new vertex is the invalid handle, at p
+  std::size_t n_replaced = 0, n_after = 0;
   Change change;
   for (int s = 0; s < 2; ++s) {
     auto h = s == 0 ? h0 : h1;
@@ -33,11 +34,13 @@ bool Remesher::split(EdgeHandle e) {
     if ((t1.normal | n_old) < 0.3 || (t2.normal | n_old) < 0.3) return false;
     change.old_min = std::min(change.old_min, old_tri.quality);
     change.new_min = std::min({change.new_min, t1.quality, t2.quality});
-    replaced.push_back(m_.face_handle(h));
-    after.push_back({from, VertexHandle(), opposite[s]});
-    after.push_back({VertexHandle(), to, opposite[s]});
+    replaced[n_replaced++] = m_.face_handle(h);
+    after[n_after++] = {from, VertexHandle(), opposite[s]};
+    after[n_after++] = {VertexHandle(), to, opposite[s]};
   }
-  if (creates_near_degenerate(change) || folds(after, replaced, VertexHandle(), p)) return false;
+  if (creates_near_degenerate(change) ||
+      folds(std::span(after.data(), n_after), std::span(replaced.data(), n_replaced), VertexHandle(), p))
+    return false;
   // Edge attributes carried by the two halves.
   bool interface = m_.interface(e), ridge = m_.ridge(e);
   int ref = m_.edge_ref(e);
@@ -66,7 +69,6 @@ bool Remesher::split(EdgeHandle e) {
     m_.required(ee) = 0;
     m_.edge_ref(ee) = half ? ref : 0;
     m_.property(ecurve_, ee) = half ? curve : kNoCurve;
-    m_.property(estamp_, ee) = 0;
     if (!m_.is_boundary(h)) {
       auto f = m_.face_handle(h);
       for (auto u : m_.fv_range(f)) {
@@ -84,14 +86,14 @@ bool Remesher::split(EdgeHandle e) {
 // fold onto a neighbour: a dihedral angle beyond 135° with an adjacent new triangle or an unchanged
 // face. The per-triangle normal tests only bound how far each triangle turns from its own old
 // normal, which on a strongly curved S (a steep terrain at 400 m) lets it turn onto a neighbour.
-bool Remesher::folds(const std::vector<std::array<VertexHandle, 3>>& triangles, const std::vector<FaceHandle>& replaced,
+bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std::span<const FaceHandle> replaced,
                      VertexHandle moved, const Vec3& at) const {
   auto position = [&](VertexHandle v) -> const Vec3& { return v == moved ? at : m_.point(v); };
   auto normal_of = [&](const std::array<VertexHandle, 3>& t) {
     return triangle(position(t[0]), position(t[1]), position(t[2])).normal;
   };
-  std::vector<Vec3> normals;
-  normals.reserve(triangles.size());
+  std::vector<Vec3>& normals = normals_;
+  normals.clear();
   for (const auto& t : triangles) normals.push_back(normal_of(t));
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     if (normals[i].sqrnorm() == 0) continue;
@@ -113,8 +115,7 @@ bool Remesher::folds(const std::vector<std::array<VertexHandle, 3>>& triangles, 
         if (!h.is_valid() || m_.is_boundary(h)) continue;
         auto f = m_.face_handle(h);
         if (std::find(replaced.begin(), replaced.end(), f) != replaced.end()) continue;
-        auto vs = face_vertices(m_, f);
-        other = normal_of({vs[0], vs[1], vs[2]});
+        other = normal_of(vertices(f));
       }
       if (other.sqrnorm() > 0 && (normals[i] | other) < kFoldCos) return true;
     }
@@ -152,25 +153,26 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change, Rule rule) const
   // Two feature edges of a triangle cannot be merged into one.
   for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
     if (m_.is_boundary(hh)) continue;
-    auto vl = m_.to_vertex_handle(m_.next_halfedge_handle(hh));
-    auto e0 = m_.edge_handle(m_.find_halfedge(v0, vl)), e1 = m_.edge_handle(m_.find_halfedge(v1, vl));
+    // The other two sides of the triangle on hh: (v0, vl) and (v1, vl), in either order.
+    auto n1 = m_.next_halfedge_handle(hh);
+    auto e0 = m_.edge_handle(n1), e1 = m_.edge_handle(m_.next_halfedge_handle(n1));
     if (m_.property(ecurve_, e0) != kNoCurve && m_.property(ecurve_, e1) != kNoCurve) return false;
   }
   if (!const_cast<SurfaceMesh&>(m_).is_collapse_ok(h)) return false;
   if ((kind == kCurveVertex || kind == kCornerVertex) && !curve_collapse_within_hausd(h)) return false;
   const Vec3& p1 = m_.point(v1);
   double old_min = 1, new_min = 1;
-  std::vector<FaceHandle> star;
-  std::vector<std::array<VertexHandle, 3>> after;
+  std::vector<FaceHandle>& star = star_;
+  std::vector<std::array<VertexHandle, 3>>& after = after_;
+  star.clear();
+  after.clear();
   for (auto f : m_.vf_range(v0)) {
     star.push_back(f);
-    auto pts = face_points(m_, f);
+    auto pts = points(f);
+    auto vs = vertices(f);
     auto old_tri = triangle(pts[0], pts[1], pts[2]);
     old_min = std::min(old_min, old_tri.quality);
-    bool has_v1 = false;
-    for (auto u : m_.fv_range(f)) has_v1 |= u == v1;
-    if (has_v1) continue;
-    auto vs = face_vertices(m_, f);
+    if (vs[0] == v1 || vs[1] == v1 || vs[2] == v1) continue;
     for (int k = 0; k < 3; ++k)
       if (vs[k] == v0) {
         pts[k] = p1;
@@ -199,12 +201,13 @@ bool Remesher::collapse(EdgeHandle e) {
   Change c0, c1;
   bool ok0 = collapse_check(h0, c0, Rule::Pass), ok1 = collapse_check(h1, c1, Rule::Pass);
   if (!ok0 && !ok1) return false;
-  collapse_halfedge((ok0 && (!ok1 || c0.new_min >= c1.new_min)) ? h0 : h1);
+  auto hc = (ok0 && (!ok1 || c0.new_min >= c1.new_min)) ? h0 : h1;
+  collapse_halfedge(hc);
   return true;
 }
 
 void Remesher::collapse_halfedge(HalfedgeHandle h) {
-  auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
+  auto v1 = m_.to_vertex_handle(h);
   // The edges (v0, vl) and (v1, vl) of each removed triangle merge: keep the union of their tags.
   struct Merge {
     VertexHandle vl;
@@ -212,17 +215,20 @@ void Remesher::collapse_halfedge(HalfedgeHandle h) {
     int ref;
     char curve;
   };
-  std::vector<Merge> merges;
+  std::array<Merge, 2> merges;
+  int n_merges = 0;
   for (auto hh : {h, m_.opposite_halfedge_handle(h)}) {
     if (m_.is_boundary(hh)) continue;
-    auto vl = m_.to_vertex_handle(m_.next_halfedge_handle(hh));
-    auto e0 = m_.edge_handle(m_.find_halfedge(v0, vl)), e1 = m_.edge_handle(m_.find_halfedge(v1, vl));
-    merges.push_back({vl, m_.interface(e0) || m_.interface(e1), m_.ridge(e0) || m_.ridge(e1),
-                      m_.required(e0) || m_.required(e1), std::max(m_.edge_ref(e0), m_.edge_ref(e1)),
-                      std::max(m_.property(ecurve_, e0), m_.property(ecurve_, e1))});
+    auto n1 = m_.next_halfedge_handle(hh), n2 = m_.next_halfedge_handle(n1);
+    auto vl = m_.to_vertex_handle(n1);
+    auto e0 = m_.edge_handle(n1), e1 = m_.edge_handle(n2);  // the two other sides, in either order
+    merges[std::size_t(n_merges++)] = {vl, m_.interface(e0) || m_.interface(e1), m_.ridge(e0) || m_.ridge(e1),
+                                       m_.required(e0) || m_.required(e1), std::max(m_.edge_ref(e0), m_.edge_ref(e1)),
+                                       std::max(m_.property(ecurve_, e0), m_.property(ecurve_, e1))};
   }
   m_.collapse(h);
-  for (const auto& mg : merges) {
+  for (int i = 0; i < n_merges; ++i) {
+    const Merge& mg = merges[std::size_t(i)];
     auto hh = m_.find_halfedge(v1, mg.vl);
     if (!hh.is_valid()) continue;
     auto ee = m_.edge_handle(hh);
@@ -247,7 +253,6 @@ bool Remesher::flip(EdgeHandle e) {
 // qualities of the two pairs.
 bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   if (m_.property(ecurve_, e) != kNoCurve || m_.is_boundary(e)) return false;
-  if (!const_cast<SurfaceMesh&>(m_).is_flip_ok(e)) return false;
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
   auto a = m_.from_vertex_handle(h0), b = m_.to_vertex_handle(h0);
   auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h0));
@@ -258,6 +263,10 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   change.new_min = std::min(t0.quality, t1.quality);
   // Only pairs with a poor triangle are worth changing in the passes: a good mesh stays as it is.
   if (change.new_min <= change.old_min + 1e-3 || (rule == Rule::Pass && change.old_min >= kFlipBelow)) return false;
+  // No new edge above the split bound (unless no longer than the one it replaces).
+  if (lengthens_beyond_split(c, d, (pd - pc).norm(), (pb - pa).norm())) return false;
+  // The link condition (cd not already an edge) last: it walks a vertex ring.
+  if (!const_cast<SurfaceMesh&>(m_).is_flip_ok(e)) return false;
   // The new pair must lie flat on S (no fold, no shortcut across curvature).
   Vec3 n = m_.property(vnormal_, a) + m_.property(vnormal_, b) + m_.property(vnormal_, c) + m_.property(vnormal_, d);
   double len = n.norm();
@@ -265,7 +274,9 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   n /= len;
   const double min_cos = rule == Rule::Pass ? kFlipFlatness : kRepairFlatness;
   if ((t0.normal | n) < min_cos || (t1.normal | n) < min_cos) return false;
-  return !folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h0), m_.face_handle(h1)});
+  const std::array<std::array<VertexHandle, 3>, 2> after{{{a, d, c}, {b, c, d}}};
+  const std::array<FaceHandle, 2> replaced{m_.face_handle(h0), m_.face_handle(h1)};
+  return !folds(after, replaced);
 }
 
 void Remesher::flip_edge(EdgeHandle e) {
@@ -295,11 +306,15 @@ double Remesher::relocate(VertexHandle v) {
   Vec3 q;
   SurfacePoint sp;
   Change change;
-  if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change)) return 0;
+  if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change) || move_lengthens(v, q)) return 0;
   // Curve vertices move only to repair a poor triangle: a point between the reference curve's
   // vertices lies on a chord, off the true curve by up to h²κ/8.
   if (kind == kCurveVertex && change.old_min >= kCurveRepairQuality) return 0;
-  bool better = change.new_min >= change.old_min || (change.new_min >= 0.6 && change.new_sum > change.old_sum);
+  // A better worst triangle, or (trading a little of it for the others) a better sum when every
+  // triangle stays ≥ 0.6 — but not for a star already good everywhere: smoothing it would only lower
+  // its worst triangle towards the others.
+  bool better = change.new_min >= change.old_min ||
+                (change.new_min >= 0.6 && change.old_min < kSmoothBelow && change.new_sum > change.old_sum);
   if (!better) return 0;
   move_vertex(v, q, sp);
   return (q - p).norm();
@@ -374,6 +389,17 @@ bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Cha
         return false;
   }
   return true;
+}
+
+// Whether moving v to q would take one of its edges above the split bound (when it was not longer
+// before): the passes after the split phase keep every edge below it.
+bool Remesher::move_lengthens(VertexHandle v, const Vec3& q) const {
+  const Vec3& p = m_.point(v);
+  for (auto w : m_.vv_range(v)) {
+    const Vec3& pw = m_.point(w);
+    if (lengthens_beyond_split(v, w, (pw - q).norm(), (pw - p).norm())) return true;
+  }
+  return false;
 }
 
 void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {

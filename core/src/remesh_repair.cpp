@@ -32,7 +32,9 @@ bool Remesher::feature_flip_check(HalfedgeHandle h, Change& change) const {
   if (change.new_min <= change.old_min + 1e-3) return false;
   // The halves lie in the plane of the face they split (c is on its side ab).
   if ((t0.normal | other.normal) < kFlipFlatness || (t1.normal | other.normal) < kFlipFlatness) return false;
-  return !folds({{a, d, c}, {b, c, d}}, {m_.face_handle(h), m_.face_handle(o)});
+  const std::array<std::array<VertexHandle, 3>, 2> after{{{a, d, c}, {b, c, d}}};
+  const std::array<FaceHandle, 2> replaced{m_.face_handle(h), m_.face_handle(o)};
+  return !folds(after, replaced);
 }
 
 void Remesher::feature_flip(HalfedgeHandle h) {
@@ -50,7 +52,6 @@ void Remesher::feature_flip(HalfedgeHandle h) {
   m_.required(e) = 0;
   m_.edge_ref(e) = 0;
   m_.property(ecurve_, e) = kNoCurve;
-  m_.property(estamp_, e) = 0;
   for (auto w : {a, b}) {
     auto half = m_.edge_handle(m_.find_halfedge(c, w));
     m_.interface(half) = interface;
@@ -72,17 +73,28 @@ void Remesher::feature_flip(HalfedgeHandle h) {
 // a flip, or a move of one of its vertices to one of a few candidate points). Unlike the passes,
 // which keep every new triangle above kAcceptQuality, this accepts any strict improvement: it is
 // what untangles clusters of slivers where every single step of the passes would be refused.
-void Remesher::repair_slivers() {
+// Returns the number of repairs; the first round starts from the faces final_sweep() found.
+std::size_t Remesher::repair_slivers() {
+  std::size_t total = 0;
+  std::vector<std::pair<double, FaceHandle>> bad = std::move(slivers_);
   for (int round = 0; round < kRepairRounds; ++round) {
-    std::vector<std::pair<double, FaceHandle>> bad;
-    for (auto f : m_.faces())
-      if (double q = face_quality(m_, f); q < kRepairBelow) bad.emplace_back(q, f);
-    std::sort(bad.begin(), bad.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    if (round > 0)
+      bad = collect<std::pair<double, FaceHandle>>(int(m_.n_faces()), [&](int i, auto& item) {
+        FaceHandle f(i);
+        if (m_.status(f).deleted()) return false;
+        auto p = points(f);
+        item = {triangle_quality(p[0], p[1], p[2]), f};
+        return item.first < kRepairBelow;
+      });
+    std::sort(bad.begin(), bad.end(),
+              [](const auto& x, const auto& y) { return x.first != y.first ? x.first < y.first : x.second.idx() < y.second.idx(); });
     std::size_t repaired = 0;
     for (auto [q, f] : bad)
       if (!m_.status(f).deleted() && face_quality(m_, f) < kRepairBelow && repair(f)) ++repaired;
+    total += repaired;
     if (repaired == 0) break;
   }
+  return total;
 }
 
 bool Remesher::repair(FaceHandle f) {
@@ -159,23 +171,10 @@ bool Remesher::repair(FaceHandle f) {
 // Every operation refuses degenerate triangles and the repair removes those of its input it can: a
 // remaining one (a configuration no local operation repairs) is reported, never silently returned.
 void Remesher::report_degenerate() const {
-  std::size_t count = 0;
-  FaceHandle first;
-  double first_area = 0;
-  for (auto f : m_.faces()) {
-    auto p = face_points(m_, f);
-    double longest2 = std::max({(p[1] - p[0]).sqrnorm(), (p[2] - p[1]).sqrnorm(), (p[0] - p[2]).sqrnorm(), hmin_ * hmin_});
-    double area = 0.5 * ((p[1] - p[0]) % (p[2] - p[0])).norm();
-    if (area < kReportArea * longest2) {
-      if (count++ == 0) {
-        first = f;
-        first_area = area;
-      }
-    }
-  }
-  if (count > 0)
-    spdlog::warn("remesh: {} degenerate triangle(s) left (face {}: area {:.3g}); no local operation could repair them",
-                 count, first.idx(), first_area);
+  if (degenerate_ > 0)
+    spdlog::warn("remesh: {} degenerate triangle(s) left (smallest area {:.3g}, near ({:.6g}, {:.6g}, {:.6g})); no local "
+                 "operation could repair them",
+                 degenerate_, degenerate_area_, degenerate_at_[0], degenerate_at_[1], degenerate_at_[2]);
 }
 
 }  // namespace bodyfit::remesh_detail

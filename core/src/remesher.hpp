@@ -22,8 +22,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <queue>
+#include <span>
 #include <vector>
 
 namespace bodyfit::remesh_detail {
@@ -44,6 +46,9 @@ inline constexpr double kCollapseRatio = 0.71;
 inline constexpr double kGoodQuality = 0.6;
 // A collapse may create triangles down to this quality (never below the worst one it removes).
 inline constexpr double kAcceptQuality = 0.4;
+// A relocation may lower a star's worst triangle (for a better sum, staying ≥ 0.6) only while that
+// worst triangle is below this quality.
+inline constexpr double kSmoothBelow = 0.9;
 // Curve vertices are relocated only when one of their triangles is below this quality.
 inline constexpr double kCurveRepairQuality = 0.6;
 // Flips are tried only when the worse triangle of the pair is below this quality.
@@ -62,6 +67,12 @@ inline constexpr double kRepairBelow = 0.3;
 inline constexpr int kRepairRounds = 5;
 // Relocation spreads at most this many rings away from a topological change or a bad element.
 inline constexpr char kSmoothRings = 3;
+// The passes stop as stalled when the work of a pass (operations plus significant moves) has not
+// fallen below kProgress times its lowest value so far for kStallPasses passes in a row.
+inline constexpr int kStallPasses = 3;
+inline constexpr double kProgress = 0.75;
+// remesh() renumbers the mesh in spatial order when its spatial_disorder() exceeds this.
+inline constexpr double kReorderAbove = 0.1;
 // A relocation moving a vertex by more than this fraction of its size re-queues its ring.
 inline constexpr double kMoveSpread = 0.05;
 // A triangle whose doubled area is at most this fraction of its summed squared edge lengths is
@@ -118,6 +129,26 @@ inline bool keeps_facing(const Tri& old_tri, const Tri& new_tri, const Vec3& sur
 // flip improves a pair below kFlipBelow) or the sliver repair's (any strict improvement).
 enum class Rule { Pass, Repair };
 
+// The results of f(i) for i in [0, n) that f sets (f returns false for none), in index order:
+// gathered in parallel by fixed blocks and concatenated, so the list never depends on the threads.
+template <class T, class F>
+std::vector<T> collect(int n, F&& f) {
+  constexpr int kBlock = 8192;
+  const int blocks = (n + kBlock - 1) / kBlock;
+  std::vector<std::vector<T>> parts(std::size_t(std::max(blocks, 0)));
+  tbb::parallel_for(0, blocks, [&](int b) {
+    T item;
+    for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
+      if (f(i, item)) parts[std::size_t(b)].push_back(item);
+  });
+  std::vector<T> all;
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.size();
+  all.reserve(total);
+  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+  return all;
+}
+
 class Remesher {
  public:
   Remesher(SurfaceMesh& mesh, const RemeshOptions& options) : m_(mesh), opt_(options) {
@@ -130,7 +161,6 @@ class Remesher {
     m_.add_property(in_next_);
     m_.add_property(depth_);
     m_.add_property(ecurve_);
-    m_.add_property(estamp_);
   }
   ~Remesher() { release(); }
   /// Drop the working properties (before garbage collection, which then has less to compact).
@@ -146,7 +176,6 @@ class Remesher {
     m_.remove_property(in_next_);
     m_.remove_property(depth_);
     m_.remove_property(ecurve_);
-    m_.remove_property(estamp_);
   }
   Remesher(const Remesher&) = delete;
   Remesher& operator=(const Remesher&) = delete;
@@ -160,14 +189,43 @@ class Remesher {
   void seed_work();
 
   double target(VertexHandle a, VertexHandle b) const { return std::min(m_.property(size_, a), m_.property(size_, b)); }
-  double length(EdgeHandle e) const { return edge_length(m_, e); }
+  double length(EdgeHandle e) const {
+    auto h = m_.halfedge_handle(e, 0);
+    return (m_.point(m_.to_vertex_handle(h)) - m_.point(m_.from_vertex_handle(h))).norm();
+  }
+  /// Length of e over its target size.
+  double ratio(EdgeHandle e) const {
+    auto h = m_.halfedge_handle(e, 0);
+    auto a = m_.from_vertex_handle(h), b = m_.to_vertex_handle(h);
+    return (m_.point(b) - m_.point(a)).norm() / target(a, b);
+  }
+  /// Whether an edge (a, b) of the given new length would be above the split bound while it was not
+  /// before (old_length): the changes after the split phase must not undo it.
+  bool lengthens_beyond_split(VertexHandle a, VertexHandle b, double new_length, double old_length) const {
+    const double bound = kSplitRatio * target(a, b);
+    return new_length > bound && new_length > old_length;
+  }
+  std::array<Vec3, 3> points(FaceHandle f) const {
+    auto h = m_.halfedge_handle(f);
+    auto h1 = m_.next_halfedge_handle(h);
+    return {m_.point(m_.to_vertex_handle(h)), m_.point(m_.to_vertex_handle(h1)),
+            m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(h1)))};
+  }
+  std::array<VertexHandle, 3> vertices(FaceHandle f) const {
+    auto h = m_.halfedge_handle(f);
+    auto h1 = m_.next_halfedge_handle(h);
+    return {m_.to_vertex_handle(h), m_.to_vertex_handle(h1), m_.to_vertex_handle(m_.next_halfedge_handle(h1))};
+  }
   void mark(VertexHandle v);
   void mark_ring(VertexHandle v);
   void mark_fresh(VertexHandle v) {
     m_.property(depth_, v) = 0;
     mark(v);
   }
-  std::vector<EdgeHandle> work_edges();
+  void work_edges(std::vector<EdgeHandle>& edges) const;
+  void split_long_edges();
+  std::size_t pass();
+  void final_sweep();
 
   bool split(EdgeHandle e);
   bool collapse(EdgeHandle e);
@@ -184,11 +242,16 @@ class Remesher {
   bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
   bool move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const;
   void move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp);
-  bool folds(const std::vector<std::array<VertexHandle, 3>>& triangles, const std::vector<FaceHandle>& replaced,
+  bool folds(std::span<const std::array<VertexHandle, 3>> triangles, std::span<const FaceHandle> replaced,
              VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
-  void repair_slivers();
+  bool move_lengthens(VertexHandle v, const Vec3& q) const;
+  std::size_t repair_slivers();
+  std::vector<std::pair<double, FaceHandle>> slivers_;  // faces below kRepairBelow (final_sweep)
   bool repair(FaceHandle f);
   void report_degenerate() const;
+  std::size_t degenerate_ = 0;  // triangles left with area < kReportArea × longest² (final_sweep)
+  double degenerate_area_ = 0;
+  Vec3 degenerate_at_{0, 0, 0};
   std::optional<std::pair<VertexHandle, VertexHandle>> curve_neighbours(VertexHandle v) const;
   Vec3 ring_centroid(VertexHandle v) const {
     Vec3 sum(0, 0, 0);
@@ -218,10 +281,14 @@ class Remesher {
   // relocation spreads into the already-good mesh.
   OpenMesh::VPropHandleT<char> depth_;
   OpenMesh::EPropHandleT<char> ecurve_;
-  OpenMesh::EPropHandleT<int> estamp_;
-  int stamp_ = 0;
   bool released_ = false;
   std::vector<VertexHandle> work_, next_;
+  // Scratch buffers reused by every pass and check (no allocation per operation).
+  std::vector<EdgeHandle> edges_;
+  std::vector<std::pair<double, EdgeHandle>> ranked_;
+  mutable std::vector<FaceHandle> star_;
+  mutable std::vector<std::array<VertexHandle, 3>> after_;
+  mutable std::vector<Vec3> normals_;
 };
 
 }  // namespace bodyfit::remesh_detail

@@ -1,7 +1,9 @@
 #pragma once
 // Interface-preserving adaptive remeshing of a surface mesh (second half of step 4 of Algorithm 1,
-// paper §3.4): split / collapse / flip / relocate until sizes and qualities settle, then repair the
-// slivers left, never folding the mesh, keeping S, the interface curve, ridges, corners, boundaries
+// paper §3.4), to any target size in one call: first every edge above the split bound is split
+// (rounds of longest-first bisection, until none is left), then collapse / flip / relocate passes run
+// until nothing changes or they stop making progress, then the slivers left are repaired; never
+// folding the mesh, keeping S, the interface curve, ridges, corners, boundaries
 // and required entities. No operation creates a (near-)degenerate triangle (area ≤ 1e-10 of its
 // squared edges, or a worst quality below min(1e-3, half the one it replaces)); a cap whose apex
 // lies on its own feature edge is repaired by flipping that edge (the feature then runs through
@@ -24,23 +26,66 @@ struct RemeshOptions {
   double hgrad = 1.3;   ///< max ratio of target sizes between neighbouring vertices
   double feature_angle = 45;  ///< dihedral angle (degrees) above which an edge is a ridge, if S's normals
                               ///< across it differ as much; ≤ 0: none
-  int max_passes = 10;  ///< outer split/collapse/flip/relocate passes
+  /// Safety cap on the collapse/flip/relocate passes; 0: none. The passes stop by themselves when
+  /// nothing is left to do or when they stop making progress (RemeshReport::stop); a cap hit is
+  /// reported as RemeshStop::PassLimit.
+  int max_passes = 0;
   /// Only work where needed: elements far from the interface that already satisfy the sizing and
   /// quality criteria are left untouched (the cost follows the part that changes).
   bool incremental = true;
   /// The fixed surface S onto which new and moved vertices are projected; when null the input
   /// mesh itself is used as reference.
   std::shared_ptr<const ReferenceSurface> reference;
+  /// After a remesh that changed the connectivity, renumber the mesh in spatial order
+  /// (reorder_spatially) when it has become scattered in memory (spatial_disorder above 10 %);
+  /// otherwise, and when false, only collect the garbage (collect_garbage).
+  bool spatial_order = true;
 };
+
+/// Why the passes stopped.
+enum class RemeshStop {
+  Converged,  ///< a pass found nothing to split, collapse or flip and moved no vertex significantly
+  Stalled,    ///< the passes kept working but made no progress (no new low of the work done per pass
+              ///< for a few passes in a row: a local oscillation, e.g. of relocations)
+  PassLimit,  ///< RemeshOptions::max_passes reached
+};
+const char* to_string(RemeshStop stop);
 
 struct RemeshReport {
   std::size_t splits = 0, collapses = 0, flips = 0, relocations = 0;
-  int passes = 0;
+  int split_rounds = 0;  ///< rounds of the first phase: every long edge split, longest first, until none is left
+  int passes = 0;        ///< collapse/flip/relocate passes after it
+  RemeshStop stop = RemeshStop::Converged;
+  /// Edges still longer than the split bound (√2 × their target size) at the end: splits refused
+  /// because they would fold or degenerate a triangle, or required edges. 0 in the normal case.
+  std::size_t long_edges = 0;
+  double max_edge_ratio = 0;  ///< longest edge / its target size
   double min_quality = 0, mean_quality = 0;
   double milliseconds = 0;
 };
 
-/// Remesh in place; `mesh` is garbage-collected on return.
+/// Remesh in place; `mesh` is garbage-collected on return (and in spatial order when it was far from
+/// it, see RemeshOptions::spatial_order).
 RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions& options = {});
+
+/// Garbage-collect `mesh` and renumber it in a spatially coherent order, so that neighbours are
+/// close in memory: vertices along a Z-order (Morton) curve of their positions in the bounding box
+/// (21 bits per axis, ties by index), then edges and faces by their smallest new vertex index (ties
+/// by index). A permutation that keeps every element's properties and the connectivity; the same
+/// result for any number of threads; a mesh already in this order is left as it is. Costs one sort
+/// of the vertices, the rest is linear.
+void reorder_spatially(SurfaceMesh& mesh);
+
+/// How scattered `mesh` is in memory: the share of its edges whose ends' indices differ by more than
+/// 16 √(vertices) (a few rows of a well-ordered mesh, whatever the order: a generator's rows, a
+/// DEM's raster, the Z-order), counting six per deleted vertex (the holes are filled from the end).
+/// 1-5 % for a generated sphere or a Z-ordered mesh; it grows as remeshes append elements.
+/// Linear, parallel.
+double spatial_disorder(const SurfaceMesh& mesh);
+
+/// Remove the deleted elements: the same arrays as OpenMesh's garbage_collection() (each hole, from
+/// the first, takes the last live element), but only the handles that point to a moved element are
+/// updated, so the cost follows the number of holes, not the size of the mesh.
+void collect_garbage(SurfaceMesh& mesh);
 
 }  // namespace bodyfit
