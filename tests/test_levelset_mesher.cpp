@@ -147,6 +147,10 @@ TEST_CASE("Hermite and linear crossings agree when φ is affine along the edges"
   CHECK(worst < 1e-14);
 }
 
+// The cutting rules alone, with snapping at 5 % of an edge (mmgs-like) and every part kept: the
+// defaults (snap at 1e-3, specks removed) are those of the evolution, tested through it.
+const DiscretizeOptions kSnapping{.snap_ratio = 0.05, .speck_area = 0};
+
 TEST_CASE("spherical cap: region areas converge to the exact cap area at order 2") {
   const double a = pi / 4;
   const double cap = 2 * pi * (1 - std::cos(a)), rest = 4 * pi - cap;
@@ -162,7 +166,7 @@ TEST_CASE("spherical cap: region areas converge to the exact cap area at order 2
 
     // Snapping only relabels parts of the faces around the snapped vertices.
     SurfaceMesh snapped = original;
-    auto report = discretize(snapped, phi);
+    auto report = discretize(snapped, phi, kSnapping);
     require_valid(snapped, strict(2, 0));
     CHECK(report.snapped_vertices > 0);
     double star_area = 0;
@@ -365,7 +369,7 @@ TEST_CASE("snapping: a level set passing within a hair of vertices makes no sliv
   auto phi_of = [&](const Vec3& p) { return p[0] - 0.5 - 1e-4 * h + 0.01 * (p[1] - 0.5); };
   SurfaceMesh reference = make_square(n);
   const double q0 = min_quality(reference);
-  const double r = DiscretizeOptions{}.snap_ratio;
+  const double r = kSnapping.snap_ratio;
   // Every piece of a face cut at fractions in [r, 1 − r] has area ≥ r²·A and edges ≤ its longest
   // edge L, hence quality ≥ 4√3 r² A / (3 L²) ≥ r² q0 / 3.
   const double bound = r * r * q0 / 3;
@@ -375,7 +379,7 @@ TEST_CASE("snapping: a level set passing within a hair of vertices makes no sliv
   CHECK(min_quality(unsnapped) < bound);  // the test can fail: without snapping, slivers appear
 
   SurfaceMesh mesh = make_square(n);
-  auto report = discretize(mesh, sample(mesh, phi_of));
+  auto report = discretize(mesh, sample(mesh, phi_of), kSnapping);
   require_valid(mesh, strict(1, 1));
   CHECK(report.snapped_vertices > 0);
   CHECK(report.rejected_snaps == 0);
@@ -415,14 +419,13 @@ DiscretizeReport check_random_cut(SurfaceMesh mesh, const ScalarField& phi, long
                                   const std::function<bool(const SurfaceMesh&, FaceHandle)>& oriented) {
   const double area = total_area(mesh), q0 = min_quality(mesh);
   const std::size_t n0 = mesh.n_vertices();
-  DiscretizeOptions options;
-  auto report = discretize(mesh, phi, options);
+  auto report = discretize(mesh, phi, kSnapping);
   require_valid(mesh, strict(euler, loops));
   CHECK(report.pinched_vertices == 0);
   CHECK(total_area(mesh) == doctest::Approx(area).epsilon(1e-12));
   CHECK(region_area(mesh, kInside) + region_area(mesh, kOutside) == doctest::Approx(area).epsilon(1e-12));
   if (report.rejected_snaps == 0 && report.separated_vertices == 0)
-    CHECK(min_quality(mesh) >= options.snap_ratio * options.snap_ratio * q0 / 3);
+    CHECK(min_quality(mesh) >= kSnapping.snap_ratio * kSnapping.snap_ratio * q0 / 3);
   for (auto f : mesh.faces()) CHECK(oriented(mesh, f));
   // φ is kept, snapped to 0, or (separated vertices) moved from 0 to the positive side.
   std::size_t separated = 0;
@@ -568,7 +571,7 @@ TEST_CASE("the quad of a two-crossing cut gets the diagonal whose worse triangle
     auto b = mesh.add_vertex(B);
     auto c = mesh.add_vertex(C);
     mesh.add_face(a, b, c);
-    discretize(mesh, {-1.0, phi_b, phi_c}, {.snap_ratio = 0});
+    discretize(mesh, {-1.0, phi_b, phi_c}, {.snap_ratio = 0, .speck_area = 0});
     require_valid(mesh, strict(1, 1));
     REQUIRE(mesh.n_faces() == 3);
     Vec3 P = A + (1 / (1 + phi_b)) * (B - A), Q = A + (1 / (1 + phi_c)) * (C - A);

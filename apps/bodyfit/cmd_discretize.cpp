@@ -63,6 +63,8 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
             auto phi = bodyfit::read_scalar_sol(*phi_file, mesh.n_vertices());
             double read_ms = clock.lap();
             std::size_t faces_before = mesh.n_faces();
+            // The default size is the input's resolution, measured before the cut adds its small edges.
+            if (options->hmax <= 0) options->hmax = bodyfit::resolution_length(mesh);
             auto report = bodyfit::discretize(mesh, phi, *cut);
             double cut_ms = clock.lap();
             auto quality = bodyfit::quality_stats(mesh);

@@ -93,6 +93,9 @@ CaseSetup setup_case(const CaseConfig& config) {
   mesh.garbage_collection();
   EvolutionOptions& options = setup.options;
   options.remesh = config.remesh;
+  // One size for the whole run when none is given: T^0's resolution, taken before the cut (whose
+  // small edges are not a resolution), as `bodyfit discretize` does.
+  if (options.remesh.hmax <= 0) options.remesh.hmax = resolution_length(mesh);
   // A landscape has no sharp features: on steep terrain many lattice edges exceed the 45° dihedral
   // angle, and ridges detected there froze the remesher (minimum quality 0.06 instead of 0.6 on
   // the fire cases). Feature detection stays off for terrains unless [remesh] angle is given.
@@ -104,7 +107,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   } else {
     mesh_initial_region(mesh, initial_level_set(config, mesh), config.discretize, options.remesh);
   }
-  setup.h = config.remesh.hmax > 0 ? config.remesh.hmax : mean_edge_length(mesh);
+  setup.h = options.remesh.hmax;
   options.dt = config.time.dt > 0 ? config.time.dt : config.time.cfl * setup.h;
   options.final_time = config.time.final_time;
   options.max_cfl = config.time.max_cfl;

@@ -229,6 +229,16 @@ double mean_edge_length(const SurfaceMesh& mesh) {
   return mesh.n_edges() ? sum / double(mesh.n_edges()) : 0.0;
 }
 
+double resolution_length(const SurfaceMesh& mesh) {
+  double area = 0;
+  std::size_t faces = 0;
+  for (auto f : mesh.faces()) {
+    area += face_area(mesh, f);
+    ++faces;
+  }
+  return faces > 0 ? std::sqrt(4 * area / (std::sqrt(3.0) * double(faces))) : 0.0;
+}
+
 EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
   EdgeLengthStats s;
   s.min = std::numeric_limits<double>::infinity();

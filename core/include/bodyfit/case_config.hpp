@@ -95,7 +95,7 @@ struct CaseConfig {
   TimeSpec time;
   DistanceOptions distance;
   AdvectionOptions advection;
-  DiscretizeOptions discretize{.snap_ratio = 1e-3, .speck_area = 0.1};  ///< as EvolutionOptions::discretize
+  DiscretizeOptions discretize;  ///< as EvolutionOptions::discretize (the same defaults as `bodyfit discretize`)
   RemeshOptions remesh;            ///< `reference` is left empty: the driver sets it
   bool remesh_angle_given = false; ///< [remesh] angle set explicitly (else off on terrains)
   OutputSpec output;

@@ -100,7 +100,7 @@ struct EvolutionOptions {
   /// by up to snap_ratio·h, which at 0.05 made the front noisy (RMS 4.7e-4 after one step at
   /// h = 0.05, Δt = h; 4.1e-5 without). Specks below 0.1 h² are absorbed (they come from noise in φ
   /// and would pin poor triangles). docs/levelset_mesher.md has the measurements.
-  DiscretizeOptions discretize{.snap_ratio = 1e-3, .speck_area = 0.1};
+  DiscretizeOptions discretize;
   RemeshOptions remesh;          ///< set `reference` so that S never drifts
   std::filesystem::path output_dir;  ///< handed to the model (StepContext::output_dir, finish)
   bool terrain = false;          ///< S is a height field (StepContext::is_terrain)

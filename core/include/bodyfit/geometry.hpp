@@ -68,6 +68,11 @@ struct EdgeLengthStats {
 EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh);
 /// Mean edge length (the h of Δt = c·h).
 double mean_edge_length(const SurfaceMesh& mesh);
+/// The mesh's resolution as one length: the side of the equilateral triangle of its mean face area,
+/// √(4 A / (√3 F)). A uniform remesh to this size keeps about as many faces, whatever the shapes of
+/// the input's triangles (stretched scans and thin parts included); the default size of the stage
+/// commands and of `run` (RemeshOptions::hmax).
+double resolution_length(const SurfaceMesh& mesh);
 
 double total_area(const SurfaceMesh& mesh);
 /// Area of the faces whose region label equals `region`.

@@ -13,7 +13,9 @@ struct DiscretizeOptions {
   /// (i.e. |φ(v)| / (|φ(v)| + |φ(w)|) < snap_ratio), v itself is put on the level set (φ(v) = 0,
   /// the vertex does not move) instead of inserting a point next to it, which would leave a sliver.
   /// A snap that would make the interface touch itself at a vertex is not done. 0 disables snapping.
-  double snap_ratio = 0.05;
+  /// The default, shared by `bodyfit discretize` and `run`, moves the interface by at most 1e-3 of
+  /// an edge: the remesher opens the slivers a near-vertex cut leaves (mmgs -ls snaps more).
+  double snap_ratio = 1e-3;
   /// The same rule for the vertices the remesher cannot move (on the boundary, on a ridge or a
   /// required edge, corners, required vertices), with the larger of the two ratios: a cut passing
   /// next to such a vertex leaves a sliver that no relocation can open, whereas a free vertex is
@@ -33,7 +35,7 @@ struct DiscretizeOptions {
   /// Such a part is below what the mesh resolves (a noise-born island of φ a fraction of one
   /// triangle across) and, as the remesher never changes the topology of the regions, it would pin
   /// a cluster of poor triangles. 0 keeps every part.
-  double speck_area = 0;
+  double speck_area = 0.1;
 };
 
 struct DiscretizeReport {

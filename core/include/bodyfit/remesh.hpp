@@ -18,10 +18,12 @@ namespace bodyfit {
 class ReferenceSurface;  // projection onto the fixed input surface S (projection.hpp)
 
 struct RemeshOptions {
-  // Sizes. 0 selects the default, relative to the bounding-box diagonal D of the mesh, so a unit
-  // sphere and a 50 km terrain need no tuning.
+  // Sizes. 0 selects the default: the mesh's own resolution (a remesh keeps about as many faces;
+  // refined only where the curvature needs it for hausd), so a unit sphere, a scan and a 50 km
+  // terrain need no tuning. Callers that cut the mesh first (discretize, run) take it from the mesh
+  // before the cut (resolution_length), since the cut's small edges are not a resolution.
   double hmin = 0;      ///< smallest edge length (default hmax / 20)
-  double hmax = 0;      ///< largest edge length (default D / 20)
+  double hmax = 0;      ///< largest edge length (default resolution_length(mesh), geometry.hpp)
   double hausd = 0;     ///< allowed distance to the true surface and interface (default D / 1000)
   double hgrad = 1.3;   ///< max ratio of target sizes between neighbouring vertices
   double feature_angle = 45;  ///< dihedral angle (degrees) above which an edge is a ridge, if S's normals
