@@ -8,7 +8,9 @@
 #  3. an out-of-tree project configured with no build type (find_package(bodyfit)): its plugin is
 #     compiled with the Release flags, and once installed to another prefix the C program loads it
 #     too; its C++ program linked to bodyfit::bodyfit_core searches the prefix's plugin directory
-#     (not the build tree's) and BODYFIT_PLUGIN_PATH first.
+#     (not the build tree's) and BODYFIT_PLUGIN_PATH first;
+#  4. the GDAL module (when built) is installed beside the plugin directory and the installed bodyfit,
+#     which does not link GDAL, loads it to read a GeoTIFF.
 #   usage: install_consumers.sh <bodyfit build dir> <bodyfit source dir>
 set -euo pipefail
 build=$(cd "$1" && pwd)
@@ -188,5 +190,16 @@ listing=$(BODYFIT_PLUGIN_PATH="$(dirname "$windy")" "$work/consumer-build/search
 echo "$listing"
 [[ $(sed -n 's/^dir //p' <<< "$listing" | head -n1) == "$(dirname "$windy")" ]] || fail "BODYFIT_PLUGIN_PATH is not searched first"
 grep -qF "model windy $windy" <<< "$listing" || fail "windy not loaded through BODYFIT_PLUGIN_PATH"
+
+if [[ -f "$build/lib/bodyfit/libbodyfit_gis.so" ]]; then
+  step "the GDAL module: installed in $libdir/bodyfit, loaded on first use by the installed bodyfit"
+  [[ -f "$libdir/bodyfit/libbodyfit_gis.so" ]] || fail "libbodyfit_gis.so not installed in $libdir/bodyfit"
+  ldd "$prefix/bin/bodyfit" | grep -qi gdal && fail "the installed bodyfit links GDAL (it must load it on demand)"
+  if command -v gdal_translate > /dev/null; then
+    gdal_translate -q -of GTiff "$source/meshes/dem/hill.asc" "$work/hill.tif"
+    "$prefix/bin/bodyfit" -q mesh terrain --dem "$work/hill.tif" -o "$work/hill.mesh" || fail "bodyfit mesh terrain --dem hill.tif"
+    [[ -s "$work/hill.mesh" ]] || fail "no mesh from the GeoTIFF"
+  fi
+fi
 
 echo "install consumers: OK"

@@ -1,21 +1,16 @@
-// Digital elevation models: ESRI ASCII grids (read/write) and GeoTIFF (read, through GDAL when
+// Digital elevation models: ESRI ASCII grids (read/write) and GeoTIFF (read, through the GDAL module when
 // bodyfit was built with it), bilinear sampling. NODATA cells are filled with the value of the
 // nearest valid cell (breadth-first over the 8-neighbourhood) and a warning says how many; a raster
 // without any valid cell is an error.
 #include <bodyfit/generators.hpp>
+
+#include "gis_module.hpp"
 #include <bodyfit/atomic_file.hpp>
-#include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-// GDAL's include directory is on the path only when bodyfit_core links GDAL (cmake/BodyfitDependencies).
-#if __has_include(<gdal.h>)
-#define BODYFIT_DEM_HAVE_GDAL 1
-#include <cpl_error.h>
-#include <gdal.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -191,61 +186,13 @@ void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid)
   });
 }
 
-namespace {
-
-[[noreturn]] void no_gdal(const std::filesystem::path& file) {
-  throw file_error(file, "cannot read GeoTIFF: bodyfit was built without GDAL (install libgdal-dev and "
-                         "reconfigure, or convert the DEM to an ESRI ASCII grid .asc)");
-}
-
-#if BODYFIT_DEM_HAVE_GDAL
-// inline: not emitted (so GDAL is not needed at link time) when config::have_gdal discards the call.
-inline HeightGrid read_geotiff_with_gdal(const std::filesystem::path& file) {
-  GDALAllRegister();
-  CPLPushErrorHandler(CPLQuietErrorHandler);
-  GDALDatasetH dataset = GDALOpen(file.string().c_str(), GA_ReadOnly);
-  CPLPopErrorHandler();
-  if (!dataset) throw file_error(file, fmt::format("cannot open as a raster (GDAL: {})", CPLGetLastErrorMsg()));
-  struct Closer {
-    GDALDatasetH d;
-    ~Closer() { GDALClose(d); }
-  } closer{dataset};
-  if (GDALGetRasterCount(dataset) < 1) throw file_error(file, "the raster has no band");
-  double gt[6];
-  if (GDALGetGeoTransform(dataset, gt) != CE_None) throw file_error(file, "the raster has no georeferencing (geotransform)");
-  if (gt[2] != 0 || gt[4] != 0) throw file_error(file, "rotated rasters are not supported");
-  if (std::abs(std::abs(gt[1]) - std::abs(gt[5])) > 1e-9 * std::abs(gt[1]) || gt[1] <= 0)
-    throw file_error(file, fmt::format("non-square or mirrored cells ({} × {}) are not supported", gt[1], gt[5]));
+HeightGrid read_geotiff(const std::filesystem::path& file) {
+  const gis::Api& gis = gis::module_for(file);
   HeightGrid grid;
-  grid.cols = std::size_t(GDALGetRasterXSize(dataset));
-  grid.rows = std::size_t(GDALGetRasterYSize(dataset));
-  grid.cell_size = gt[1];
-  grid.x_origin = gt[0];
-  grid.y_origin = gt[5] < 0 ? gt[3] + double(grid.rows) * gt[5] : gt[3];
-  GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
-  int has_nodata = 0;
-  double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
-  if (has_nodata) grid.nodata = nodata;
-  grid.heights.resize(grid.rows * grid.cols);
-  if (GDALRasterIO(band, GF_Read, 0, 0, int(grid.cols), int(grid.rows), grid.heights.data(), int(grid.cols),
-                   int(grid.rows), GDT_Float64, 0, 0) != CE_None)
-    throw file_error(file, fmt::format("cannot read band 1 (GDAL: {})", CPLGetLastErrorMsg()));
-  if (gt[5] > 0)  // south-up raster: store north first like an ESRI grid
-    for (std::size_t r = 0; r < grid.rows / 2; ++r)
-      std::swap_ranges(grid.heights.begin() + long(r * grid.cols), grid.heights.begin() + long((r + 1) * grid.cols),
-                       grid.heights.begin() + long((grid.rows - 1 - r) * grid.cols));
+  std::string error;
+  if (!gis.read_raster(file, grid, error)) throw file_error(file, error);
   fill_nodata(grid, file);
   return grid;
-}
-#endif
-
-}  // namespace
-
-HeightGrid read_geotiff(const std::filesystem::path& file) {
-#if BODYFIT_DEM_HAVE_GDAL
-  if constexpr (config::have_gdal) return read_geotiff_with_gdal(file);
-#endif
-  no_gdal(file);
 }
 
 HeightGrid read_dem(const std::filesystem::path& file) {

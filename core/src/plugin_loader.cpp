@@ -1,6 +1,8 @@
 // Finding plugins on the search path, dlopen-ing them, checking their ABI and creating models.
 #include <bodyfit/plugin_loader.hpp>
 
+#include "core_location.hpp"
+
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/parameters.hpp>
@@ -77,13 +79,8 @@ std::vector<fs::path> plugin_files(const fs::path& dir) {
 /// one that was moved or one installed with `cmake --install --prefix` each find their own plugins.
 /// No path of the build tree is compiled in: the installed library holds none.
 fs::path plugin_dir_beside_core() {
-  static const char anchor = 0;
-  Dl_info info;
-  if (!dladdr(&anchor, &info) || !info.dli_fname) return {};
-  std::error_code ec;
-  fs::path library = fs::weakly_canonical(fs::path(info.dli_fname), ec);
-  if (ec) return {};
-  return library.parent_path() / config::plugin_dir_from_libdir;
+  const fs::path dir = core_library_directory();
+  return dir.empty() ? dir : dir / config::plugin_dir_from_libdir;
 }
 
 }  // namespace

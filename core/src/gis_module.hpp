@@ -1,0 +1,33 @@
+#pragma once
+// Everything bodyfit does through GDAL lives in a module loaded on first use (core/gis/,
+// libbodyfit_gis.so in <libdir>/bodyfit/ beside libbodyfit_core): linked into the core, GDAL made
+// every command map its ~110 libraries at start (0.1 s of each `bodyfit distance` or `remesh`
+// call, which never reads a raster). The module is part of bodyfit, built with it from the same
+// sources and headers, so C++ types cross the boundary; the table of entry points grows as the
+// GIS functions do, under one exported symbol.
+#include <bodyfit/generators.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+namespace bodyfit::gis {
+
+inline constexpr std::uint32_t kApiVersion = 1;
+
+/// The module's entry points.
+struct Api {
+  std::uint32_t version = kApiVersion;
+  /// Band 1 of a north-up raster with square cells into `grid` (NODATA cells as they are); false
+  /// with `error` set when GDAL cannot read the file as such.
+  bool (*read_raster)(const std::filesystem::path& file, HeightGrid& grid, std::string& error) = nullptr;
+};
+
+/// The module, loaded on the first call. An InputError naming `file` when bodyfit was built
+/// without GDAL or when the module cannot be loaded (with dlopen's reason).
+const Api& module_for(const std::filesystem::path& file);
+
+}  // namespace bodyfit::gis
+
+/// Defined by the module: its table of entry points.
+extern "C" const bodyfit::gis::Api* bodyfit_gis_api();
