@@ -9,6 +9,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -351,6 +352,64 @@ TEST_CASE("dem: malformed ESRI ASCII grids name the file and the line") {
   }
   CHECK_THROWS_AS(read_esri_ascii(dir / "does_not_exist.asc"), InputError);
   CHECK_THROWS_AS(read_dem(dir / "x.xyz"), InputError);
+}
+
+/// The ESRI WKT of WGS 84 / UTM zone `zone` north, as `gdalsrsinfo -o wkt_esri EPSG:326zz` writes it.
+std::string utm_prj(int zone) {
+  return fmt::format(
+      "PROJCS[\"WGS_1984_UTM_Zone_{}N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\","
+      "6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION["
+      "\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],"
+      "PARAMETER[\"Central_Meridian\",{}.0],PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\","
+      "0.0],UNIT[\"Meter\",1.0]]",
+      zone, 6 * zone - 183);
+}
+
+TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone to use, a projected one kept and written") {
+  bodyfit::test::TempDir dir("dem_crs");
+  HeightGrid g = plane_grid();
+  if (!config::have_gdal) {
+    write_esri_ascii(dir / "g.asc", g);
+    write_text(dir / "g.prj", utm_prj(32));
+    CHECK_THROWS_WITH_AS(read_dem(dir / "g.asc"), doctest::Contains("without GDAL"), InputError);
+    return;
+  }
+  // SRTM-style degrees over Luxembourg (6° E, 49.6° N): the error names zone 32N (EPSG:32632).
+  HeightGrid degrees = g;
+  degrees.x_origin = 6.0;
+  degrees.y_origin = 49.6;
+  degrees.cell_size = 0.003;
+  write_esri_ascii(dir / "deg.asc", degrees);
+  write_text(dir / "deg.prj",
+             "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],"
+             "PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]");
+  CHECK_THROWS_WITH_AS(read_dem(dir / "deg.asc"), doctest::Contains("geographic"), InputError);
+  CHECK_THROWS_WITH_AS(read_dem(dir / "deg.asc"), doctest::Contains("EPSG:32632"), InputError);
+  // A projected system in US feet is refused too.
+  write_esri_ascii(dir / "feet.asc", g);
+  std::string feet = utm_prj(18);
+  feet.replace(feet.find("UNIT[\"Meter\",1.0]"), std::string("UNIT[\"Meter\",1.0]").size(),
+               "UNIT[\"Foot_US\",0.3048006096012192]");
+  write_text(dir / "feet.prj", feet);
+  CHECK_THROWS_WITH_AS(read_dem(dir / "feet.asc"), doctest::Contains("units of 0.3048"), InputError);
+
+  // UTM: kept with the grid, written beside what is written, the same system when read back.
+  write_esri_ascii(dir / "utm.asc", g);
+  write_text(dir / "utm.prj", utm_prj(32));
+  HeightGrid utm = read_dem(dir / "utm.asc");
+  REQUIRE(!utm.crs.empty());
+  write_esri_ascii(dir / "copy.asc", utm);
+  REQUIRE(std::filesystem::exists(dir / "copy.prj"));
+  HeightGrid copy = read_dem(dir / "copy.asc");
+  CHECK(copy.crs == utm.crs);
+  CHECK_NOTHROW(require_same_crs(utm, dir / "utm.asc", copy, dir / "copy.asc"));
+  // Another zone is another system: an error naming both files; an unknown system matches any.
+  write_esri_ascii(dir / "zone31.asc", g);
+  write_text(dir / "zone31.prj", utm_prj(31));
+  HeightGrid zone31 = read_dem(dir / "zone31.asc");
+  CHECK_THROWS_WITH_AS(require_same_crs(utm, dir / "utm.asc", zone31, dir / "zone31.asc"),
+                       doctest::Contains("zone31.asc"), InputError);
+  CHECK_NOTHROW(require_same_crs(utm, dir / "utm.asc", g, dir / "none.asc"));
 }
 
 TEST_CASE("dem: a GeoTIFF made by gdal_translate reads as the .asc it came from") {

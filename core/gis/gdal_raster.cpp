@@ -1,12 +1,14 @@
-// The GDAL module (see core/src/gis_module.hpp): rasters read through GDAL.
+// The GDAL module (see core/src/gis_module.hpp): rasters and coordinate systems through GDAL/OSR.
 #include "gis_module.hpp"
 
 #include <cpl_error.h>
 #include <gdal.h>
+#include <ogr_srs_api.h>
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace bodyfit::gis {
 namespace {
@@ -52,10 +54,47 @@ bool read_raster(const std::filesystem::path& file, HeightGrid& grid, std::strin
     for (std::size_t r = 0; r < grid.rows / 2; ++r)
       std::swap_ranges(grid.heights.begin() + long(r * grid.cols), grid.heights.begin() + long((r + 1) * grid.cols),
                        grid.heights.begin() + long((grid.rows - 1 - r) * grid.cols));
+  if (const char* wkt = GDALGetProjectionRef(dataset)) grid.crs = wkt;
   return true;
 }
 
-const Api kApi{.version = kApiVersion, .read_raster = read_raster};
+/// An OSR spatial reference, released at the end of the scope.
+struct Srs {
+  OGRSpatialReferenceH h = OSRNewSpatialReference(nullptr);
+  ~Srs() { OSRDestroySpatialReference(h); }
+  bool parse(const std::string& wkt) {
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    const bool ok = OSRSetFromUserInput(h, wkt.c_str()) == OGRERR_NONE;
+    CPLPopErrorHandler();
+    return ok;
+  }
+};
+
+bool describe_crs(const std::string& wkt, CrsInfo& info, std::string& error) {
+  Srs srs;
+  if (!srs.parse(wkt)) {
+    error = fmt::format("cannot read the coordinate system (GDAL: {})", CPLGetLastErrorMsg());
+    return false;
+  }
+  info = CrsInfo{};
+  if (const char* name = OSRGetName(srs.h)) info.name = name;
+  info.geographic = OSRIsGeographic(srs.h) != 0;
+  if (OSRIsProjected(srs.h)) info.metres_per_unit = OSRGetLinearUnits(srs.h, nullptr);
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  OSRAutoIdentifyEPSG(srs.h);
+  CPLPopErrorHandler();
+  const char* authority = OSRGetAuthorityName(srs.h, nullptr);
+  const char* code = OSRGetAuthorityCode(srs.h, nullptr);
+  if (authority && code && std::string(authority) == "EPSG") info.epsg = std::atoi(code);
+  return true;
+}
+
+bool same_crs(const std::string& a, const std::string& b) {
+  Srs x, y;
+  return x.parse(a) && y.parse(b) && OSRIsSame(x.h, y.h) != 0;
+}
+
+const Api kApi{.version = kApiVersion, .read_raster = read_raster, .describe_crs = describe_crs, .same_crs = same_crs};
 
 }  // namespace
 }  // namespace bodyfit::gis

@@ -3,10 +3,10 @@
 // nearest valid cell (breadth-first over the 8-neighbourhood) and a warning says how many; a raster
 // without any valid cell is an error.
 #include <bodyfit/generators.hpp>
-
-#include "gis_module.hpp"
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
+
+#include "gis_module.hpp"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -14,9 +14,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -82,6 +84,60 @@ double HeightGrid::sample(double x, double y) const {
   const double upper_row = (1 - fu) * south(s1, c0) + fu * south(s1, c1);
   return (1 - fv) * lower_row + fv * upper_row;
 }
+
+namespace {
+
+std::filesystem::path prj_beside(const std::filesystem::path& file) {
+  std::filesystem::path prj = file;
+  return prj.replace_extension(".prj");
+}
+
+/// The coordinate system of an ESRI grid: the text of the .prj beside it ("" when there is none).
+std::string read_prj(const std::filesystem::path& file) {
+  const auto prj = prj_beside(file);
+  std::error_code ec;
+  if (!std::filesystem::exists(prj, ec)) return {};
+  std::ifstream in(prj);
+  if (!in) throw file_error(prj, "cannot open for reading");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) text.pop_back();
+  if (text.empty()) throw file_error(prj, "empty coordinate system file (expected WKT, e.g. from gdalsrsinfo -o wkt_esri)");
+  return text;
+}
+
+/// Degrees are not metres. A geographic raster is refused, with the UTM zone of its centre to
+/// project it to; a projected one in other units than metres too. Without a coordinate system,
+/// coordinates that look like degrees get a warning.
+void require_metres(const HeightGrid& grid, const std::filesystem::path& file) {
+  const double west = grid.x_origin, south = grid.y_origin;
+  const double east = west + grid.cell_size * double(grid.cols), north = south + grid.cell_size * double(grid.rows);
+  const double lon = 0.5 * (west + east), lat = 0.5 * (south + north);
+  const int zone = std::clamp(int(std::floor((lon + 180) / 6)) + 1, 1, 60);
+  const std::string projection =
+      fmt::format("gdalwarp -t_srs EPSG:{}{:02d} {} projected.tif` (WGS 84 / UTM zone {}{}, that of its centre)",
+                  lat >= 0 ? 326 : 327, zone, file.string(), zone, lat >= 0 ? 'N' : 'S');
+  if (grid.crs.empty()) {
+    if (grid.cell_size < 0.01 && west >= -180 && east <= 180 && south >= -90 && north <= 90)
+      spdlog::warn("{}: no coordinate system (no .prj) and cells of {} m: if these are degrees, project the raster "
+                   "first, e.g. `{}",
+                   file.string(), grid.cell_size, projection);
+    return;
+  }
+  const gis::Api& gis = gis::module_for(file);
+  gis::CrsInfo info;
+  std::string error;
+  if (!gis.describe_crs(grid.crs, info, error)) throw file_error(file, error);
+  if (info.geographic)
+    throw file_error(file, fmt::format("its coordinate system '{}' is geographic (degrees of longitude and latitude), "
+                                       "and bodyfit works in metres: project the raster first, e.g. `{}",
+                                       info.name, projection));
+  if (std::abs(info.metres_per_unit - 1) > 1e-9)
+    throw file_error(file, fmt::format("its coordinate system '{}' measures in units of {} m, and bodyfit works in "
+                                       "metres: reproject it to a metric system (gdalwarp -t_srs)",
+                                       info.name, info.metres_per_unit));
+}
+
+}  // namespace
 
 HeightGrid read_esri_ascii(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -164,6 +220,7 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file) {
     throw file_error(file, line_no, fmt::format("truncated: expected {} values ({} rows × {} columns), found {}",
                                                 expected, grid.rows, grid.cols, grid.heights.size()));
   fill_nodata(grid, file);
+  grid.crs = read_prj(file);
   return grid;
 }
 
@@ -184,6 +241,7 @@ void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid)
       out << row;
     }
   });
+  if (!grid.crs.empty()) write_atomically(prj_beside(file), [&](std::ostream& out) { out << grid.crs << '\n'; });
 }
 
 HeightGrid read_geotiff(const std::filesystem::path& file) {
@@ -197,9 +255,26 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
 
 HeightGrid read_dem(const std::filesystem::path& file) {
   const std::string ext = lower(file.extension().string());
-  if (ext == ".asc") return read_esri_ascii(file);
-  if (ext == ".tif" || ext == ".tiff") return read_geotiff(file);
-  throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  HeightGrid grid;
+  if (ext == ".asc") grid = read_esri_ascii(file);
+  else if (ext == ".tif" || ext == ".tiff") grid = read_geotiff(file);
+  else throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  require_metres(grid, file);
+  return grid;
+}
+
+void require_same_crs(const HeightGrid& a, const std::filesystem::path& file_a, const HeightGrid& b,
+                      const std::filesystem::path& file_b) {
+  if (a.crs.empty() || b.crs.empty() || a.crs == b.crs) return;
+  const gis::Api& gis = gis::module_for(file_a);
+  if (gis.same_crs(a.crs, b.crs)) return;
+  gis::CrsInfo info_a, info_b;
+  std::string error;
+  gis.describe_crs(a.crs, info_a, error);
+  gis.describe_crs(b.crs, info_b, error);
+  throw InputError(fmt::format("{} and {} have different coordinate systems ('{}' and '{}'): reproject one onto the "
+                               "other (gdalwarp -t_srs)",
+                               file_a.string(), file_b.string(), info_a.name, info_b.name));
 }
 
 }  // namespace bodyfit

@@ -15,8 +15,8 @@ namespace bodyfit::gis {
 
 const Api& module_for(const std::filesystem::path& file) {
   if constexpr (!config::have_gdal)
-    throw file_error(file, "cannot read GeoTIFF: bodyfit was built without GDAL (install libgdal-dev and "
-                           "reconfigure, or convert the raster to an ESRI ASCII grid .asc)");
+    throw file_error(file, "GeoTIFF rasters and coordinate systems need GDAL, and bodyfit was built without GDAL "
+                           "(install libgdal-dev and reconfigure; or give an ESRI ASCII grid .asc without a .prj)");
   static std::once_flag once;
   static const Api* api = nullptr;
   static std::string failure;

@@ -15,12 +15,25 @@ namespace bodyfit::gis {
 
 inline constexpr std::uint32_t kApiVersion = 1;
 
+/// What bodyfit needs to know of a coordinate system.
+struct CrsInfo {
+  std::string name;          ///< e.g. "WGS 84 / UTM zone 32N"
+  bool geographic = false;   ///< longitude/latitude in degrees
+  double metres_per_unit = 1;  ///< of a projected system's linear unit
+  int epsg = 0;              ///< its EPSG code when it has one
+};
+
 /// The module's entry points.
 struct Api {
   std::uint32_t version = kApiVersion;
-  /// Band 1 of a north-up raster with square cells into `grid` (NODATA cells as they are); false
-  /// with `error` set when GDAL cannot read the file as such.
+  /// Band 1 of a north-up raster with square cells into `grid` (NODATA cells as they are, its
+  /// coordinate system as WKT in grid.crs); false with `error` set when GDAL cannot read the file.
   bool (*read_raster)(const std::filesystem::path& file, HeightGrid& grid, std::string& error) = nullptr;
+  /// A coordinate system given as WKT (ESRI's .prj dialect included); false with `error` set when
+  /// it cannot be understood.
+  bool (*describe_crs)(const std::string& wkt, CrsInfo& info, std::string& error) = nullptr;
+  /// Whether two WKT texts describe the same coordinate system.
+  bool (*same_crs)(const std::string& a, const std::string& b) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built

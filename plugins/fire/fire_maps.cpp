@@ -183,8 +183,9 @@ ScalarField ArrivalRaster::sample_at_vertices(const SurfaceMesh& mesh) const {
   return values;
 }
 
-void ArrivalRaster::write(const std::filesystem::path& file) const {
+void ArrivalRaster::write(const std::filesystem::path& file, const std::string& crs) const {
   HeightGrid out = grid_;
+  out.crs = crs;
   for (double& value : out.heights)
     if (std::isnan(value)) value = out.nodata;
   write_esri_ascii(file, out);

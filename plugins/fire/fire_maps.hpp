@@ -42,7 +42,8 @@ class ArrivalRaster {
               std::span<const int> changed = {});
   /// Arrival time at the vertices (bilinear over reached cells; NaN where none is reached yet).
   ScalarField sample_at_vertices(const SurfaceMesh& mesh) const;
-  void write(const std::filesystem::path& file) const;
+  /// As an ESRI ASCII grid, with a .prj beside it when `crs` (WKT) is known.
+  void write(const std::filesystem::path& file, const std::string& crs = {}) const;
   const HeightGrid& grid() const { return grid_; }
   /// Into / back from a checkpoint's model state (keys "arrival.*"); load leaves the raster
   /// uninitialised when the state has none.

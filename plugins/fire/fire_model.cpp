@@ -74,8 +74,10 @@ class FireModel final : public VelocityModel {
       if (wind_.type == "grid") {
         if (!w.has("u_file") || !w.has("v_file"))
           throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
-        wind_.u = read_dem(w.path("u_file"));
-        wind_.v = read_dem(w.path("v_file"));
+        wind_u_file_ = w.path("u_file");
+        wind_v_file_ = w.path("v_file");
+        wind_.u = read_dem(wind_u_file_);
+        wind_.v = read_dem(wind_v_file_);
       } else {
         w.accept("u_file");
         w.accept("v_file");
@@ -106,6 +108,7 @@ class FireModel final : public VelocityModel {
           throw InputError(std::string("[model.fuel] presets: ") + e.what());
         }
       }
+      fuel_file_ = map;
       if (!map.empty()) fuel_map_ = read_dem(map);
       f.reject_unknown();
     }
@@ -113,8 +116,27 @@ class FireModel final : public VelocityModel {
       Parameters a(*arrival, "model.arrival");
       arrival_cell_ = a.number("cell_size", 0, {.min = 0});
       const std::filesystem::path like = a.path("like");
+      arrival_like_file_ = like;
       if (!like.empty()) arrival_like_ = read_dem(like);
       a.reject_unknown();
+    }
+    // The rasters of one case share one coordinate system, which the outputs then carry.
+    std::vector<std::pair<const HeightGrid*, std::filesystem::path>> rasters;
+    if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
+    if (wind_.u.cols > 0) rasters.emplace_back(&wind_.u, wind_u_file_);
+    if (wind_.v.cols > 0) rasters.emplace_back(&wind_.v, wind_v_file_);
+    if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
+    crs_.clear();
+    const HeightGrid* first = nullptr;
+    std::filesystem::path first_file;
+    for (const auto& [grid, file] : rasters) {
+      if (grid->crs.empty()) continue;
+      if (first) require_same_crs(*first, first_file, *grid, file);
+      else {
+        first = grid;
+        first_file = file;
+        crs_ = grid->crs;
+      }
     }
     p.reject_unknown();
   }
@@ -206,7 +228,7 @@ class FireModel final : public VelocityModel {
   }
 
   void finish(const std::filesystem::path& output_dir) override {
-    if (arrival_.initialised() && !output_dir.empty()) arrival_.write(output_dir / "arrival_time.asc");
+    if (arrival_.initialised() && !output_dir.empty()) arrival_.write(output_dir / "arrival_time.asc", crs_);
   }
 
  private:
@@ -224,6 +246,8 @@ class FireModel final : public VelocityModel {
   WindField wind_;
   double arrival_cell_ = 0;
   HeightGrid arrival_like_;
+  std::string crs_;
+  std::filesystem::path fuel_file_, wind_u_file_, wind_v_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
 };
 

@@ -36,6 +36,9 @@ struct HeightGrid {
   double cell_size = 1;               ///< metres
   double nodata = -9999;
   std::vector<double> heights;        ///< rows × cols, row 0 is the northernmost
+  /// The coordinate system as WKT: a GeoTIFF's, or the .prj beside an .asc (written beside it too);
+  /// "" when unknown. read_dem refuses a geographic one (degrees are not metres).
+  std::string crs;
   double at(std::size_t row, std::size_t col) const { return heights[row * cols + col]; }
   /// Bilinear interpolation at (x, y), cell-centre registered; clamps outside the grid.
   double sample(double x, double y) const;
@@ -48,6 +51,10 @@ void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid)
 HeightGrid read_geotiff(const std::filesystem::path& file);
 /// Dispatch on extension (.asc, .tif/.tiff).
 HeightGrid read_dem(const std::filesystem::path& file);
+/// An InputError naming both files when two rasters of one case have different coordinate systems
+/// (an unknown one, "", matches any).
+void require_same_crs(const HeightGrid& a, const std::filesystem::path& file_a, const HeightGrid& b,
+                      const std::filesystem::path& file_b);
 
 struct TerrainOptions {
   double extent = 50000;     ///< side of the square domain, metres
