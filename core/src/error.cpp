@@ -9,6 +9,9 @@ ExitCode exit_code_of(const std::exception& e) {
   if (dynamic_cast<const PluginError*>(&e)) return ExitCode::Plugin;
   if (dynamic_cast<const NumericalError*>(&e)) return ExitCode::Numerical;
   if (dynamic_cast<const IoError*>(&e)) return ExitCode::Io;
+  // std::filesystem operations of the drivers (creating an output directory, removing a stale
+  // file): the reading side checks its files itself, so what is left is writing.
+  if (dynamic_cast<const std::filesystem::filesystem_error*>(&e)) return ExitCode::Io;
   return ExitCode::Internal;
 }
 
@@ -18,6 +21,10 @@ InputError file_error(const std::filesystem::path& file, long line, const std::s
 
 InputError file_error(const std::filesystem::path& file, const std::string& what) {
   return InputError(fmt::format("{}: {}", file.string(), what));
+}
+
+IoError write_error(const std::filesystem::path& file, const std::string& what) {
+  return IoError(fmt::format("{}: {}", file.string(), what));
 }
 
 }  // namespace bodyfit

@@ -50,5 +50,7 @@ ExitCode exit_code_of(const std::exception& e);
 InputError file_error(const std::filesystem::path& file, long line, const std::string& what);
 /// "<file>: <what>" — an error that concerns a file as a whole (or a byte offset given in `what`).
 InputError file_error(const std::filesystem::path& file, const std::string& what);
+/// "<file>: <what>" — an output that cannot be written (ExitCode::Io).
+IoError write_error(const std::filesystem::path& file, const std::string& what);
 
 }  // namespace bodyfit
