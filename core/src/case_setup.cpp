@@ -3,6 +3,7 @@
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/projection.hpp>
 
@@ -101,6 +102,10 @@ CaseSetup setup_case(const CaseConfig& config) {
   // the fire cases). Feature detection stays off for terrains unless [remesh] angle is given.
   if (config.surface.kind == SurfaceSpec::Kind::Terrain && !config.remesh_angle_given) options.remesh.feature_angle = 0;
   options.remesh.reference = make_case_reference(config, mesh);
+  // Every remesh of the run aims at these sizes: refuse a run whose meshes cannot fit.
+  check_face_budget(estimate_remesh_faces(mesh, options.remesh),
+                    config.remesh.hmax > 0 ? fmt::format("[remesh] hmax = {}", config.remesh.hmax)
+                                           : std::string("[remesh] the default hmax (diagonal / 20)"));
   if (config.region.kind == RegionSpec::Kind::Refs) {
     label_from_refs(config, mesh);
     remesh(mesh, options.remesh);

@@ -1,6 +1,7 @@
 // A flat square: the open surface of the plane cases (a disk growing, an interface sliding along a
 // boundary).
 #include <bodyfit/generators.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
@@ -24,6 +25,7 @@ SurfaceMesh make_plane(const PlaneOptions& options) {
   if (!positive(size)) throw InputError(fmt::format("plane: the size must be positive (got {})", size));
   if (!positive(h)) throw InputError(fmt::format("plane: the edge length h must be positive (got {})", h));
   const double row_height = h * std::sqrt(3.0) / 2;
+  check_face_budget(2 * (size / h) * (size / row_height), fmt::format("plane of size {} and edge length {}", size, h));
   if ((size / h + 2) * (size / row_height + 1) > kMaxVertices)
     throw InputError(fmt::format("plane: size {} with h {} is too many vertices; use a larger h", size, h));
 

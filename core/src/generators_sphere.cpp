@@ -15,6 +15,9 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/guards.hpp>
+
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
@@ -374,6 +377,7 @@ SpherePlan plan_sphere(std::size_t faces) {
 SurfaceMesh make_sphere(const SphereOptions& options) {
   if (options.faces < 20) throw InputError("sphere: --faces must be at least 20");
   if (!(options.radius > 0) || !std::isfinite(options.radius)) throw InputError("sphere: --radius must be positive");
+  check_face_budget(double(options.faces), fmt::format("sphere of {} faces", options.faces));
   const SpherePlan plan = plan_sphere(options.faces);
   SurfaceMesh mesh;
   if (plan.a > 0 && plan.b == 0) {

@@ -2,6 +2,7 @@
 // over a rectangle with a triangular lattice whose rows are shifted by half a step, so the triangles
 // are near-equilateral in plan view and the four sides are straight rows/columns of vertices.
 #include <bodyfit/generators.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
@@ -69,6 +70,8 @@ void check_terrain_options(const TerrainOptions& o) {
 SurfaceMesh lattice_mesh(double x0, double x1, double y0, double y1, double h,
                          const std::function<double(double, double)>& height) {
   const double row_height = h * std::sqrt(3.0) / 2;
+  check_face_budget(2 * std::max(1.0, (x1 - x0) / h) * std::max(1.0, (y1 - y0) / row_height),
+                    fmt::format("terrain of {} × {} at edge length {}", x1 - x0, y1 - y0, h));
   const long nx = std::max(1L, std::lround((x1 - x0) / h));
   const long ny = std::max(1L, std::lround((y1 - y0) / row_height));
   if (double(nx + 2) * double(ny + 1) > kMaxVertices)
