@@ -19,9 +19,13 @@
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/guards.hpp>
+
+#include <fmt/format.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
@@ -92,6 +96,8 @@ struct Surface {
   std::vector<int> vertex_order;         ///< vertices in Z-order: neighbours trace through the same faces
   std::vector<int> vertex_rank;          ///< position of each vertex in vertex_order
   std::vector<int> fan_start, fan;       ///< vertex → its faces (CSR, slots), built on first band call
+  std::vector<float> face_length;        ///< mean edge length of each face (slot)
+  double shortest_face = 0;              ///< the smallest of them (> 0 on a mesh that was read)
 };
 
 /// The walk's geometry (everything but the velocity), in Z-order.
@@ -134,6 +140,7 @@ Surface build_surface(const SurfaceMesh& mesh) {
   s.faces.resize(nf);
   s.motion.resize(nf);
   s.corners.resize(nf);
+  s.face_length.resize(nf);
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& range) {
     for (int slot = range.begin(); slot != range.end(); ++slot) {
       const int fi = face_order[slot];
@@ -145,6 +152,7 @@ Surface build_surface(const SurfaceMesh& mesh) {
       m.epoch = 0;
       double mean = 0;
       for (int k = 0; k < 3; ++k) mean += (p[(k + 2) % 3] - p[(k + 1) % 3]).norm() / 3.0;
+      s.face_length[slot] = float(mean);
       for (int k = 0; k < 3; ++k)
         m.edge2[k] = mean > 0 ? float((p[(k + 2) % 3] - p[(k + 1) % 3]).sqrnorm() / (mean * mean)) : 0.0f;
       for (int i = 0; i < 3; ++i) {
@@ -183,6 +191,7 @@ Surface build_surface(const SurfaceMesh& mesh) {
       }
     }
   });
+  s.shortest_face = nf ? double(*std::min_element(s.face_length.begin(), s.face_length.end())) : 0.0;
   // One incident face per vertex, chosen deterministically (the first in storage order).
   s.vertex_face.assign(nv, -1);
   s.vertex_slot.assign(nv, 0);
@@ -359,7 +368,7 @@ struct TraceResult {
 /// Trace the characteristic through `start` backwards over a time T, reading V on the faces whose
 /// motion was filled by the call `epoch`.
 TraceResult trace(const Surface& s, Location start, double T, const AdvectionOptions& opt, std::uint32_t epoch,
-                  std::vector<Crossed>& path) {
+                  std::size_t max_substeps, std::vector<Crossed>& path) {
   TraceResult r;
   auto known = [&](int face) { return s.motion[face].epoch == epoch; };
   Location x = start;
@@ -400,6 +409,12 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
                                                             : remaining;
       }
       if (dt >= remaining * (1 - 1e-12)) dt = remaining;  // no sliver of a last step
+      // The bound of every trace (trace_vertices): a speed that overflows (dt = 0) or a trace
+      // that took more sub-steps than its fastest crossing of the smallest face allows is lost.
+      if (!(dt > 0) || r.substeps >= max_substeps) {
+        r.stalled = true;
+        break;
+      }
       remaining = dt == remaining ? 0.0 : remaining - dt;
       ++r.substeps;
       if (opt.rk_order == 4) {
@@ -444,14 +459,80 @@ void check_inputs(const SurfaceMesh& mesh, std::size_t phi_size, std::size_t oth
   if (options.rk_order != 2 && options.rk_order != 4) throw InputError("advect: rk_order must be 2 or 4");
   if (!(options.max_cells_per_substep > 0)) throw InputError("advect: max_cells_per_substep must be positive");
   if (options.steps < 1) throw InputError("advect: steps must be at least 1");
+  if (!(options.max_substeps >= 0)) throw InputError("advect: max_substeps must be ≥ 0 (0: no limit)");
+}
+
+/// |v| without overflow of the squares (|V| = 1e200 is finite, its square is not).
+double length_of(const Vec3& v) {
+  const double scale = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (!(scale > 0) || !std::isfinite(scale)) return scale;
+  return scale * (v / scale).norm();
+}
+
+/// Largest |V| over `vertices` (all when empty); InputError at a non-finite V.
+double largest_speed(const VectorField& velocity, std::span<const int> vertices) {
+  auto speed = [&](std::size_t v) {
+    const double value = length_of(velocity[v]);
+    if (!std::isfinite(value))
+      throw InputError(fmt::format("advect: the velocity at vertex {} is not finite ({}, {}, {})", v + 1,
+                                   velocity[v][0], velocity[v][1], velocity[v][2]));
+    return value;
+  };
+  const std::size_t n = vertices.empty() ? velocity.size() : vertices.size();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, n, 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double largest) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+          largest = std::max(largest, speed(vertices.empty() ? k : std::size_t(vertices[k])));
+        return largest;
+      },
+      [](double a, double b) { return std::max(a, b); });
+}
+
+/// The sub-steps one trace may take: its fastest possible crossing of the smallest face, with the
+/// margin of the step sizing (a step is kept while it crosses more than half the cells asked for).
+std::size_t substep_bound(const Surface& s, double vmax, double T, const AdvectionOptions& options) {
+  const double cells = s.shortest_face > 0 ? vmax * T / (options.max_cells_per_substep * s.shortest_face)
+                                           : std::numeric_limits<double>::infinity();
+  const double bound = 4 * cells + 4.0 * options.steps + 16;
+  return bound < 1e18 ? std::size_t(bound) : std::size_t(1e18);
+}
+
+/// Refuse a call whose estimated sub-steps (each traced vertex's |V|·T in cells of its face, at
+/// least `steps`) exceed options.max_substeps, before any tracing.
+void check_substep_budget(const Surface& s, const VectorField& velocity, std::span<const int> order, double T,
+                          const AdvectionOptions& options) {
+  if (options.max_substeps == 0) return;
+  const double cells = options.max_cells_per_substep;
+  const double total = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, order.size(), 4096), 0.0,
+      [&](const tbb::blocked_range<std::size_t>& range, double sum) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+          const int v = order[k];
+          const int f = s.vertex_face[v];
+          if (f < 0) continue;
+          const double length = double(s.face_length[f]);
+          const double reach = length > 0 ? length_of(velocity[v]) * T / (cells * length) : 0.0;
+          sum += std::max(double(options.steps), std::ceil(reach));
+        }
+        return sum;
+      },
+      [](double a, double b) { return a + b; });
+  if (total > options.max_substeps)
+    throw InputError(fmt::format(
+        "advect: about {:.3g} sub-steps for {} characteristics (T = {}, {} edge length(s) per sub-step), above the "
+        "limit of {:.3g}; shorten the time or the velocity, or raise the limit (advect --max-substeps, "
+        "[advection] max_substeps; 0: no limit)",
+        total, order.size(), T, cells, options.max_substeps));
 }
 
 /// Trace the vertices of `order` and write φ(T) at them into out (φ at the foot, P1 or corrected
 /// with the vertex `gradients` of φ).
 void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField* gradients, std::span<const int> order,
-                    double T, const AdvectionOptions& options, std::uint32_t epoch, ScalarField& out,
+                    double T, const AdvectionOptions& options, std::uint32_t epoch, double vmax, ScalarField& out,
                     AdvectionReport* report) {
   const std::vector<Vec3>& points = s.points;
+  const std::size_t max_substeps = substep_bound(s, vmax, T, options);
   std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
     std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0, local_outside = 0;
@@ -467,7 +548,7 @@ void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField*
       start.face = fi;
       start.b[0] = start.b[1] = start.b[2] = 0.0;
       start.b[s.vertex_slot[v]] = 1.0;
-      const TraceResult r = trace(s, start, T, options, epoch, path);
+      const TraceResult r = trace(s, start, T, options, epoch, max_substeps, path);
       const std::array<int, 3>& c = s.corners[r.foot.face];
       double value = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
       if (gradients && !r.outside) {
@@ -523,14 +604,16 @@ ScalarField Advector::advect(const ScalarField& phi, const VectorField& velocity
   Impl& a = *impl_;
   check_inputs(a.mesh, phi.size(), velocity.size(), T, options, "the velocity");
   Surface& s = a.surface;
+  const double vmax = largest_speed(velocity, {});
+  check_substep_budget(s, velocity, s.vertex_order, T, options);
   const std::uint32_t epoch = ++a.epoch;
   tbb::parallel_for(tbb::blocked_range<int>(0, int(s.faces.size()), 4096), [&](const tbb::blocked_range<int>& range) {
     for (int slot = range.begin(); slot != range.end(); ++slot) fill_motion(s, slot, velocity, epoch);
   });
   if (options.gradient_correction) a.gradients = vertex_gradients(a.mesh, phi);
   ScalarField out(phi.size(), 0.0);
-  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, s.vertex_order, T, options, epoch, out,
-                 report);
+  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, s.vertex_order, T, options, epoch, vmax,
+                 out, report);
   return out;
 }
 
@@ -542,6 +625,8 @@ void Advector::advect_band(const ScalarField& phi, const VectorField& velocity, 
   if (out.size() != phi.size()) throw InputError("advect_band: the output has one value per vertex");
   Surface& s = a.surface;
   const std::size_t nv = s.points.size();
+  const double vmax = largest_speed(velocity, known);
+  check_substep_budget(s, velocity, traced, T, options);
   const std::uint32_t epoch = ++a.epoch;
   if (s.fan_start.empty()) build_fans(s);
   a.vertex_seen.resize(nv, 0);
@@ -568,7 +653,8 @@ void Advector::advect_band(const ScalarField& phi, const VectorField& velocity, 
   // Z-order for the traces, as in a full call.
   a.order.assign(traced.begin(), traced.end());
   std::sort(a.order.begin(), a.order.end(), [&](int u, int w) { return s.vertex_rank[u] < s.vertex_rank[w]; });
-  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, out, report);
+  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, vmax, out,
+                 report);
 }
 
 ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,

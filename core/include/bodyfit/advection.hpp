@@ -20,20 +20,28 @@ struct AdvectionOptions {
   /// such as a distance function, the Taylor planes under-estimate it), so the mean removes the
   /// inward drift of a convex front that P1 interpolation causes at every step.
   bool gradient_correction = true;
+  /// Budget of one call: the sub-steps it would take are estimated before tracing (each vertex's
+  /// |V|·T over the cells of its face, at least `steps`) and the call refused (InputError) above
+  /// this many in total; 0: no limit. About 10⁸ sub-steps a second per core: the default is a
+  /// minute or so, a few hundred times a CFL-sized step.
+  double max_substeps = 1e9;
 };
 
 struct AdvectionReport {
   std::size_t traced = 0;            ///< characteristics traced (= vertices)
   std::size_t hit_boundary = 0;      ///< stopped on the boundary of an open surface
   std::size_t substeps = 0;          ///< total sub-steps over all vertices
-  std::size_t lost = 0;              ///< characteristics that failed (must stay 0)
+  std::size_t lost = 0;              ///< characteristics that failed (must stay 0): a walk that
+                                     ///< stalled, or a trace that reached its bound of sub-steps
   /// Band calls: reached a face where V is not known and stopped there (a characteristic running
   /// away from the front, whose sign the stop does not change).
   std::size_t outside_band = 0;
 };
 
 /// Solve ∂φ/∂t + V·∇_S φ = 0 on (0, T), V given at the vertices (projected on the tangent plane
-/// where evaluated). Returns φ(T) at the vertices. Deterministic for any thread count.
+/// where evaluated). Returns φ(T) at the vertices. Deterministic for any thread count. Every trace
+/// is bounded: by the sub-steps its speed needs on the smallest face (and so is the call, by
+/// AdvectionOptions::max_substeps, checked before tracing); V must be finite.
 ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,
                    const AdvectionOptions& options = {}, AdvectionReport* report = nullptr);
 
