@@ -2,6 +2,7 @@
 // into a CaseConfig. Setting up the run from it is case_setup.cpp.
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/parameters.hpp>
 
 #include <fmt/format.h>
@@ -61,10 +62,12 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
       const std::int64_t faces = p.integer("faces", 0, 20);
       const double h = p.number("h", 0, kPositive);
       if ((faces > 0) == (h > 0)) p.fail("sphere: give exactly one of 'faces' and 'h'");
-      // Mean edge h: 4πR² ≈ F·(√3/4)h².
-      out.sphere.faces = faces > 0 ? std::size_t(faces)
-                                   : std::size_t(std::lround(16 * std::numbers::pi * out.sphere.radius *
-                                                             out.sphere.radius / (std::sqrt(3.0) * h * h)));
+      // Mean edge h: 4πR² ≈ F·(√3/4)h². Refused here, before the count is rounded, when too many.
+      const double count = faces > 0 ? double(faces)
+                                      : faces_for_edge_length(4 * std::numbers::pi * out.sphere.radius * out.sphere.radius, h);
+      check_face_budget(count, faces > 0 ? fmt::format("[surface] faces = {}", faces)
+                                         : fmt::format("[surface] h = {} on a sphere of radius {}", h, out.sphere.radius));
+      out.sphere.faces = std::size_t(std::llround(std::min(count, 1e18)));  // 1e18: only with --max-faces 0
       p.forbid({"extent", "seed", "dem", "size", "max_height", "feature_size"}, "to generator 'sphere'");
     } else if (g == "terrain") {
       out.kind = SurfaceSpec::Kind::Terrain;
@@ -194,6 +197,7 @@ void parse_stages(const toml::table& table, CaseConfig& config) {
     if (rk_order != 2 && rk_order != 4) p.fail("rk_order", fmt::format("must be 2 or 4 (got {})", rk_order));
     out.rk_order = int(rk_order);
     out.max_cells_per_substep = p.number("max_cells_per_substep", out.max_cells_per_substep, kPositive);
+    out.max_substeps = p.number("max_substeps", out.max_substeps, {.min = 0});
     out.steps = clamp_to_int(p.integer("steps", out.steps, 1));
     out.gradient_correction = p.boolean("gradient_correction", out.gradient_correction);
     p.reject_unknown();
@@ -217,7 +221,7 @@ void parse_stages(const toml::table& table, CaseConfig& config) {
     out.hgrad = p.number("hgrad", out.hgrad, {.min = 1});
     config.remesh_angle_given = p.has("angle");
     out.feature_angle = p.number("angle", out.feature_angle);
-    out.max_passes = clamp_to_int(p.integer("max_passes", out.max_passes));
+    out.max_passes = clamp_to_int(p.integer("max_passes", out.max_passes, 0));  // 0: no cap
     out.incremental = p.boolean("incremental", out.incremental);
     if (out.hmin > 0 && out.hmax > 0 && out.hmin > out.hmax)
       p.fail("hmin", fmt::format("{} must not exceed hmax = {}", out.hmin, out.hmax));

@@ -38,6 +38,14 @@ std::optional<double> as_number(const toml::node& node) {
   return std::nullopt;
 }
 
+/// Why `value` is refused by `range` ("" when accepted): TOML's inf and nan are never accepted,
+/// whatever the range (no parameter means "infinitely"; an absent key gives the default).
+std::string refusal(double value, const Range& range) {
+  if (!std::isfinite(value)) return fmt::format("{} is not a finite number", value);
+  if (!range.contains(value)) return fmt::format("{} is out of range {}", value, range.describe());
+  return {};
+}
+
 /// "[a, b]" for integers, the type's limits shown as infinite ("[0, inf)").
 std::string describe_integers(std::int64_t min, std::int64_t max) {
   using limits = std::numeric_limits<std::int64_t>;
@@ -98,7 +106,7 @@ double Parameters::number(std::string_view key, double fallback, Range range) {
   if (!node) return fallback;
   auto value = as_number(*node);
   if (!value) fail(key, fmt::format("expected a number, got {}", type_name(*node)));
-  if (!range.contains(*value)) fail(key, fmt::format("{} is out of range {}", *value, range.describe()));
+  if (auto why = refusal(*value, range); !why.empty()) fail(key, why);
   return *value;
 }
 
@@ -165,7 +173,7 @@ std::vector<double> Parameters::numbers(std::string_view key, std::vector<double
   for (const auto& element : *array) {
     auto value = as_number(element);
     if (!value) fail(key, fmt::format("expected an array of numbers, found {} in it", type_name(element)));
-    if (!range.contains(*value)) fail(key, fmt::format("{} is out of range {}", *value, range.describe()));
+    if (auto why = refusal(*value, range); !why.empty()) fail(key, why);
     values.push_back(*value);
   }
   if (size && values.size() != *size) fail(key, fmt::format("expected {} numbers, got {}", *size, values.size()));
@@ -187,8 +195,7 @@ std::vector<std::vector<double>> Parameters::number_arrays(std::string_view key,
     for (const auto& entry : *row) {
       auto value = as_number(entry);
       if (!value) fail(key, fmt::format("item {}: expected {} numbers, found {} in it", item, size, type_name(entry)));
-      if (!range.contains(*value))
-        fail(key, fmt::format("item {}: {} is out of range {}", item, *value, range.describe()));
+      if (auto why = refusal(*value, range); !why.empty()) fail(key, fmt::format("item {}: {}", item, why));
       values.push_back(*value);
     }
     rows.push_back(std::move(values));
