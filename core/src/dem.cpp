@@ -54,6 +54,19 @@ void fill_nodata(HeightGrid& grid, const std::filesystem::path& file) {
   spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid height", file.string(), missing, n);
 }
 
+// Heights beyond this are not terrain (the Earth's radius is 6.4e6 m; in feet, 2.1e7): a NODATA
+// marker the header does not declare, or a damaged cell. A mesh built on one would be refused
+// later anyway, by whichever stage first squares its size.
+constexpr double kMaxHeight = 1e8;
+
+void check_heights(const HeightGrid& grid, const std::filesystem::path& file) {
+  for (std::size_t i = 0; i < grid.heights.size(); ++i)
+    if (!(std::abs(grid.heights[i]) <= kMaxHeight))
+      throw file_error(file, fmt::format("the height {} of the cell at row {}, column {} is beyond ±{:.0e}: not a "
+                                         "terrain height (a NODATA value the header does not declare?)",
+                                         grid.heights[i], i / grid.cols + 1, i % grid.cols + 1, kMaxHeight));
+}
+
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   return s;
@@ -202,6 +215,14 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file) {
 
   const std::size_t expected = grid.rows * grid.cols;
   if (double(grid.rows) * double(grid.cols) > 4e8) throw file_error(file, "raster too large");
+  // Each value takes two bytes at least ("0 "): a header that declares more than the file can hold
+  // is refused before memory is reserved for it.
+  std::error_code size_error;
+  const auto bytes = std::filesystem::file_size(file, size_error);
+  if (!size_error && double(expected) > double(bytes) / 2 + 1)
+    throw file_error(file, fmt::format("the header declares {} rows × {} columns, more values than the file's {} "
+                                       "bytes can hold (truncated?)",
+                                       grid.rows, grid.cols, bytes));
   grid.heights.reserve(expected);
   auto take = [&](const std::string& token, long at_line) {
     auto value = parse_number(token);
@@ -220,6 +241,7 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file) {
     throw file_error(file, line_no, fmt::format("truncated: expected {} values ({} rows × {} columns), found {}",
                                                 expected, grid.rows, grid.cols, grid.heights.size()));
   fill_nodata(grid, file);
+  check_heights(grid, file);
   grid.crs = read_prj(file);
   return grid;
 }
@@ -250,6 +272,7 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
   std::string error;
   if (!gis.read_raster(file, grid, error)) throw file_error(file, error);
   fill_nodata(grid, file);
+  check_heights(grid, file);
   return grid;
 }
 

@@ -9,6 +9,7 @@
 #include "io_internal.hpp"
 
 #include <bodyfit/atomic_file.hpp>
+#include <bodyfit/guards.hpp>
 
 #include <fmt/format.h>
 
@@ -926,6 +927,13 @@ std::vector<SolField> read_sol_all(const std::filesystem::path& file, std::size_
   if (expected_vertices != 0 && n != expected_vertices)
     throw where(fmt::format("SolAtVertices has {} values per field, but the mesh has {} vertices", n,
                             expected_vertices));
+  for (std::size_t k = 0; k < result.fields.size(); ++k) {
+    const SolField& f = result.fields[k];
+    if (const std::size_t i = find_non_finite(f.values); i < f.values.size())
+      throw file_error(file, fmt::format("SolAtVertices: field {}, vertex {} has the value {} (every value must be "
+                                         "finite)",
+                                         k + 1, i / std::size_t(f.dimension) + 1, f.values[i]));
+  }
   return std::move(result.fields);
 }
 

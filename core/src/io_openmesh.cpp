@@ -10,8 +10,13 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <fmt/format.h>
 
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
 #include <iostream>
 #include <sstream>
+#include <string_view>
 
 namespace bodyfit::io_detail {
 namespace {
@@ -48,10 +53,98 @@ class CaptureOpenMeshErrors {
   bool log_was_enabled_ = true;
 };
 
+/// The next whitespace-separated word of `text` from `at` on, skipping '#' comments (OFF), "" at the end.
+std::string_view next_word(std::string_view text, std::size_t& at) {
+  for (;;) {
+    while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+    if (at < text.size() && text[at] == '#') {
+      while (at < text.size() && text[at] != '\n') ++at;
+      continue;
+    }
+    break;
+  }
+  const std::size_t start = at;
+  while (at < text.size() && !std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+  return text.substr(start, at - start);
+}
+
+/// A count of the header: a non-negative integer, else an InputError naming it.
+std::uint64_t header_count(std::string_view word, const std::filesystem::path& file, const char* what) {
+  std::int64_t value = -1;
+  auto [ptr, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+  if (ec != std::errc() || ptr != word.data() + word.size() || value < 0)
+    throw file_error(file, fmt::format("the header's {} '{}' is not a count (a non-negative integer)", what, word));
+  return std::uint64_t(value);
+}
+
+/// The counts a header declares must fit in the file (each record takes at least a few bytes),
+/// before OpenMesh reserves memory for them: a damaged header is an error, not a 137 GB allocation
+/// or an empty mesh. STL: a file that is not ASCII ("solid ...") is binary, whose size is exact.
+void check_declared_counts(std::string_view bytes, const std::string& ext, const std::filesystem::path& file) {
+  const std::uint64_t size = bytes.size();
+  auto needs = [](std::uint64_t vertices, std::uint64_t faces, double vertex_bytes, double face_bytes) {
+    return double(vertices) * vertex_bytes + double(faces) * face_bytes;
+  };
+  auto fits = [&](std::uint64_t vertices, std::uint64_t faces, double vertex_bytes, double face_bytes) {
+    const double needed = needs(vertices, faces, vertex_bytes, face_bytes);
+    if (needed > double(size))
+      throw file_error(file, fmt::format("the header declares {} vertices and {} faces, which need at least {:.0f} "
+                                         "bytes; the file has {} (truncated or not this format?)",
+                                         vertices, faces, needed, size));
+  };
+  if (ext == ".stl") {
+    std::size_t at = 0;
+    const bool ascii = next_word(bytes, at) == "solid";
+    std::uint32_t triangles = 0;
+    if (size >= 84) std::memcpy(&triangles, bytes.data() + 80, 4);  // little-endian, as the format
+    const std::uint64_t binary_size = 84 + 50 * std::uint64_t(triangles);
+    if (!ascii && (size < 84 || binary_size != size))
+      throw file_error(file, size < 84 ? fmt::format("not an STL file: no 'solid' line and {} bytes, less than a "
+                                                     "binary STL's 84-byte header",
+                                                     size)
+                                       : fmt::format("binary STL: the header declares {} triangles ({} bytes), the "
+                                                     "file has {} bytes (truncated or not an STL file?)",
+                                                     triangles, binary_size, size));
+  } else if (ext == ".off") {
+    std::size_t at = 0;
+    const std::string_view keyword = next_word(bytes, at);
+    if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF")
+      throw file_error(file, "not an OFF file: it does not start with 'OFF'");
+    std::size_t after = at;
+    const bool binary = next_word(bytes, after) == "BINARY";
+    if (binary) {
+      if (size < after + 12) throw file_error(file, "binary OFF: truncated header");
+      std::uint32_t counts[2];
+      std::memcpy(counts, bytes.data() + after + 1, 8);  // after the newline that ends "BINARY"
+      // Either byte order (writers differ): refused only when neither fits.
+      if (needs(counts[0], counts[1], 12, 16) > double(size))
+        fits(__builtin_bswap32(counts[0]), __builtin_bswap32(counts[1]), 12, 16);
+    } else {
+      const std::uint64_t vertices = header_count(next_word(bytes, at), file, "vertex count");
+      const std::uint64_t faces = header_count(next_word(bytes, at), file, "face count");
+      fits(vertices, faces, 6, 8);  // "0 0 0\n", "3 0 1 2\n"
+    }
+  } else if (ext == ".ply") {
+    const std::size_t end = bytes.find("end_header");
+    if (end == std::string_view::npos) throw file_error(file, "not a PLY file: no 'end_header'");
+    std::uint64_t counts[2] = {0, 0};
+    for (std::size_t at = 0; at < end;) {
+      const std::string_view word = next_word(bytes, at);
+      if (word != "element") continue;
+      const std::string_view name = next_word(bytes, at);
+      const std::uint64_t n = header_count(next_word(bytes, at), file, "element count");
+      if (name == "vertex") counts[0] = n;
+      if (name == "face") counts[1] = n;
+    }
+    fits(counts[0], counts[1], 3, 4);  // the smallest binary records
+  }
+}
+
 }  // namespace
 
 SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options) {
-  read_file_bytes(file);  // a clear error for a missing or unreadable file
+  // A clear error for a missing or unreadable file, and for counts the file cannot hold.
+  check_declared_counts(read_file_bytes(file), extension_of(file), file);
   SurfaceMesh raw;
   OpenMesh::IO::Options io_options;
   std::string complaint;
