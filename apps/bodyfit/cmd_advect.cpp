@@ -1,8 +1,10 @@
 // bodyfit advect: carry a level set along a tangential velocity field on the surface by the method
 // of characteristics (the Advection stage of the pipeline).
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/advection.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 
 #include <spdlog/spdlog.h>
@@ -29,7 +31,7 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
   cmd->add_option("mesh", args->mesh, "surface mesh")->required();
   cmd->add_option("--phi", args->phi, "level set at the vertices (.sol)")->required();
   cmd->add_option("--velocity", args->velocity, "velocity at the vertices (vector .sol)")->required();
-  cmd->add_option("--time", args->time, "final time T")->required()->check(CLI::NonNegativeNumber);
+  cmd->add_option("--time", args->time, "final time T")->required()->check(bodyfit::cli::finite_at_least(0));
   cmd->add_option("--steps", args->options.steps, "outer steps over (0, T)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -41,7 +43,11 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
                 "expansions, which removes the O(h²) interpolation bias)");
   cmd->add_option("--cells", args->options.max_cells_per_substep, "edge lengths crossed per sub-step, at most about")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(bodyfit::cli::finite_above(0));
+  cmd->add_option("--max-substeps", args->options.max_substeps,
+                  "refuse to start when the sub-steps of all characteristics are estimated above this (0: no limit)")
+      ->capture_default_str()
+      ->check(bodyfit::cli::finite_at_least(0));
   cmd->add_option("-o,--output", args->output, "advected level set (.sol)")->required();
   return {cmd, [args]() {
             const auto start = std::chrono::steady_clock::now();
@@ -54,6 +60,7 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
             args->options.gradient_correction = !args->plain_p1;
             const auto result = bodyfit::advect(mesh, phi, velocity, args->time, args->options, &report);
             const double advect_ms = ms_since(advect_start);
+            bodyfit::require_finite(result, "advect: the advected level set");
             bodyfit::write_scalar_sol(args->output, result);
             spdlog::info(
                 "advect: {} vertices, {} faces, T = {}, RK{}; {} characteristics, {} sub-steps, {} stopped on the "

@@ -2,8 +2,10 @@
 // the output carries the regions (refs 3 inside, 2 outside) and the interface edges (ref 10).
 #include "commands.hpp"
 #include "remesh_options.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/remesh.hpp>
@@ -37,30 +39,32 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
   auto cut = std::make_shared<bodyfit::DiscretizeOptions>();
   auto options = std::make_shared<bodyfit::RemeshOptions>();
   auto no_remesh = std::make_shared<bool>(false);
-  cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required();
   cmd->add_option("--phi", *phi_file, "level set at the vertices (.sol/.solb, negative inside)")
-      ->required()
-      ->check(CLI::ExistingFile);
+      ->required();
   cmd->add_option("-o,--output", *output, "output mesh (.mesh keeps refs, readable by MMG)")->required();
   cmd->add_option("--snap", cut->snap_ratio,
                   "put a vertex on the level set when the crossing is closer than this fraction of the edge")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.5));
+      ->check(bodyfit::cli::finite_in(0.0, 0.5));
   cmd->add_option("--snap-fixed", cut->fixed_snap_ratio,
                   "the same for vertices the remesher cannot move (boundary, ridges, corners, required); "
                   "the larger of the two applies")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.5));
+      ->check(bodyfit::cli::finite_in(0.0, 0.5));
   cmd->add_option("--speck", cut->speck_area,
                   "give parts of a region smaller than this many h² (h: mean edge length) to the region around them")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(bodyfit::cli::finite_at_least(0));
   bodyfit::cli::add_remesh_options(*cmd, *options);
   cmd->add_flag("--no-remesh", *no_remesh, "only cut the level set in (thin triangles remain)");
   return {cmd, [=]() {
             Stopwatch clock;
             auto mesh = bodyfit::read_mesh(*input);
             auto phi = bodyfit::read_scalar_sol(*phi_file, mesh.n_vertices());
+            if (!*no_remesh)
+              bodyfit::check_face_budget(bodyfit::estimate_remesh_faces(mesh, *options),
+                                         "discretize: edges of at most hmax");
             double read_ms = clock.lap();
             std::size_t faces_before = mesh.n_faces();
             // The default size is the input's resolution, measured before the cut adds its small edges.

@@ -1,9 +1,11 @@
 // bodyfit distance: signed geodesic distance to the zero set of a level set, or to a labelled region
 // (the Mshdist stage of the pipeline).
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/distance.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 
 #include <spdlog/spdlog.h>
@@ -29,7 +31,7 @@ bodyfit::cli::Command setup_distance(CLI::App& app) {
                                  "distance to the faces with this ref (interface: the edges between them and the rest)");
   phi->excludes(region);
   cmd->add_option("--narrow-band", args->narrow_band, "stop beyond this |d| (those vertices get ±1e300); 0: everywhere")
-      ->check(CLI::NonNegativeNumber);
+      ->check(bodyfit::cli::finite_at_least(0));
   cmd->add_option("-o,--output", args->output, "output distance (.sol)")->required();
   return {cmd, [args, phi, region]() {
             if (phi->count() == 0 && region->count() == 0)
@@ -56,6 +58,7 @@ bodyfit::cli::Command setup_distance(CLI::App& app) {
             // Medit files cannot hold infinities portably: write ±1e300 instead.
             for (double& value : d)
               if (std::isinf(value)) value = value > 0 ? 1e300 : -1e300;
+            bodyfit::require_finite(d, "distance: the signed distance");
             bodyfit::write_scalar_sol(args->output, d);
             const double total =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -1,5 +1,6 @@
 // bodyfit mesh sphere|terrain: mesh generators.
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
@@ -31,20 +32,26 @@ bodyfit::cli::Command setup_mesh(CLI::App& app) {
 
   auto* sph = cmd->add_subcommand("sphere", "geodesic sphere: near-equilateral triangles, vertices exactly on the sphere");
   sph->add_option("--faces", sphere->faces, "target number of triangles, ≥ 20 (result within ±10 %)")->capture_default_str();
-  sph->add_option("--radius", sphere->radius, "radius")->capture_default_str();
+  sph->add_option("--radius", sphere->radius, "radius")->capture_default_str()->check(bodyfit::cli::finite_above(0));
   sph->add_option("-o,--output", *output, formats)->required();
 
   auto* ter = cmd->add_subcommand(
       "terrain",
       "terrain over a square (procedural, seeded) or over a DEM's extent: near-equilateral triangles of edge ≈ h, "
       "straight sides, normals up. Coordinates in metres.");
-  ter->add_option("--extent", terrain->extent, "side of the square domain [0, extent]² (procedural)")->capture_default_str();
+  ter->add_option("--extent", terrain->extent, "side of the square domain [0, extent]² (procedural)")
+      ->capture_default_str()
+      ->check(bodyfit::cli::finite_above(0));
   auto* h_option = ter->add_option("--h", terrain->h, "target edge length (with --dem: default the cell size)")
-                       ->capture_default_str();
+                       ->capture_default_str()
+                       ->check(bodyfit::cli::finite_above(0));
   ter->add_option("--seed", terrain->seed, "the landscape is a deterministic function of the seed")->capture_default_str();
-  ter->add_option("--max-height", terrain->max_height, "heights lie in [0, max-height] (procedural)")->capture_default_str();
+  ter->add_option("--max-height", terrain->max_height, "heights lie in [0, max-height] (procedural)")
+      ->capture_default_str()
+      ->check(bodyfit::cli::finite_at_least(0));
   ter->add_option("--feature-size", terrain->feature_size, "horizontal scale of the largest hills (procedural)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(bodyfit::cli::finite_above(0));
   ter->add_option("--dem", *dem, "DEM raster: ESRI ASCII grid .asc or GeoTIFF .tif; heights by bilinear interpolation");
   ter->add_option("-o,--output", *output, formats)->required();
 

@@ -4,6 +4,7 @@
 #include "remesh_options.hpp"
 
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/remesh.hpp>
 
@@ -19,18 +20,20 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
   auto input = std::make_shared<std::string>();
   auto output = std::make_shared<std::string>();
   auto options = std::make_shared<bodyfit::RemeshOptions>();
-  cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("input", *input, "input mesh (.mesh, .meshb, ...)")->required();
   cmd->add_option("-o,--output", *output, "output mesh (.mesh keeps refs, readable by MMG)")->required();
   bodyfit::cli::add_remesh_options(*cmd, *options);
   cmd->add_option("--passes", options->max_passes,
                   "cap on the collapse/flip/relocate passes (0: none; they stop when done or when they stop making "
                   "progress)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--full", [options](std::int64_t) { options->incremental = false; },
                 "work on every vertex, not only where the mesh needs change");
   return {cmd, [=]() {
             auto start = std::chrono::steady_clock::now();
             auto mesh = bodyfit::read_mesh(*input);
+            bodyfit::check_face_budget(bodyfit::estimate_remesh_faces(mesh, *options), "remesh: edges of at most hmax");
             auto before = bodyfit::quality_stats(mesh);
             std::size_t faces_before = mesh.n_faces();
             auto report = bodyfit::remesh(mesh, *options);

@@ -1,8 +1,12 @@
 // bodyfit: body-fitted tracking of a region moving inside a fixed surface.
 #include "commands.hpp"
+#include "mmg_spellings.hpp"
 
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/guards.hpp>
+
+#include <fmt/format.h>
 
 #include <malloc.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
@@ -56,6 +60,12 @@ int main(int argc, char** argv) {
   int threads = 0;
   app.add_option("--threads", threads, "worker threads of the parallel stages (0: all cores); results do not depend on it")
       ->check(CLI::Range(0, 4096));
+  std::size_t max_faces = default_max_faces();
+  app.add_option("--max-faces", max_faces,
+                 fmt::format("refuse to build or remesh to more faces than this, estimated before starting (0: no "
+                             "limit; default: what fits in 3/4 of this machine's memory at {:.0f} bytes per face)",
+                             kBytesPerFace))
+      ->capture_default_str();
 
   auto& commands = cli::registry();
   std::stable_sort(commands.begin(), commands.end(),
@@ -63,11 +73,16 @@ int main(int argc, char** argv) {
   std::vector<cli::Command> added;
   for (auto& [order, setup] : commands) added.push_back(setup(app));
 
-  // MMG's spellings (-hmax 0.1): CLI11 would read "-hmax" as the flags -h -m -a -x, print the
-  // help and exit 0 — a script written for mmgs would carry on as if the stage had run.
-  std::vector<std::string> arguments(argv + 1, argv + argc);
-  for (auto& a : arguments)
-    if (a == "-hmax" || a == "-hmin" || a == "-hausd" || a == "-hgrad") a = "-" + a;
+  // MMG's spellings (-hmax 0.1, -in, -out, -sol, -ls, -nr): translated on discretize and remesh,
+  // refused elsewhere (mmg_spellings.hpp) — never the help and exit 0.
+  std::vector<std::string> names;
+  for (const auto& command : added) names.push_back(command.app->get_name());
+  auto translation = cli::translate_mmg_spellings(std::vector<std::string>(argv + 1, argv + argc), names);
+  if (translation.error) {
+    std::fprintf(stderr, "bodyfit: %s\n", translation.error->c_str());
+    return int(ExitCode::Usage);
+  }
+  std::vector<std::string> arguments = std::move(translation.arguments);
   std::reverse(arguments.begin(), arguments.end());  // CLI11 takes the arguments in reverse
 
   try {
@@ -77,6 +92,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : int(ExitCode::Usage);  // not CLI11's raw 105-114
   }
 
+  set_max_faces(max_faces);
   // oneTBB's limit for the whole process, the plugins' parallel loops included.
   std::optional<tbb::global_control> thread_limit;
   if (threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
