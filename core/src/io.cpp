@@ -194,22 +194,6 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
       throw r.triangle_at.error(file, t, fmt::format("triangle {} uses the same vertex twice", t + 1));
     for (int k = 0; k < 3; ++k) length_sum += (r.points[tri[(k + 1) % 3]] - r.points[tri[k]]).norm();
   }
-  // Every vertex is a corner: a stray one would stretch the bounding box, and with it every default
-  // size (relative to its diagonal), without being part of the surface. Refused rather than dropped:
-  // dropping it would renumber the vertices, and a .sol written for this mesh would no longer match.
-  {
-    std::vector<char> used(r.points.size(), 0);
-    for (const auto& tri : r.triangles)
-      for (auto i : tri) used[std::size_t(i)] = 1;
-    const auto unused = std::size_t(std::count(used.begin(), used.end(), 0));
-    if (unused > 0) {
-      const auto first = std::size_t(std::find(used.begin(), used.end(), 0) - used.begin());
-      throw r.vertex_at.error(file, first,
-                              fmt::format("vertex {} is not a corner of any triangle ({} such vertices): it would "
-                                          "stretch the bounding box and so the default sizes; remove it",
-                                          first + 1, unused));
-    }
-  }
   if (!r.triangles.empty()) {
     const double mean_length = length_sum / (3.0 * double(r.triangles.size()));
     const double min_area = options.min_relative_area * mean_length * mean_length;
@@ -259,29 +243,6 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
         throw r.vertex_at.error(file, std::size_t(v.idx()),
                                 fmt::format("vertex {} is non-manifold: two separate fans of triangles meet there",
                                             v.idx() + 1));
-    }
-  }
-
-  // Two boundary vertices at the same point: a vertex written twice, which cuts a closed surface
-  // open along the faces that use the copy (a boundary where there is none). Boundary vertices only:
-  // they are few, and a duplicate that opens nothing cannot lie anywhere else.
-  {
-    std::vector<int> boundary;
-    for (auto v : mesh.vertices())
-      if (mesh.is_boundary(v)) boundary.push_back(v.idx());
-    auto key = [&](int v) {
-      const Vec3& p = mesh.point(VertexHandle(v));
-      return std::array<double, 4>{p[0], p[1], p[2], double(v)};
-    };
-    std::sort(boundary.begin(), boundary.end(), [&](int a, int b) { return key(a) < key(b); });
-    for (std::size_t k = 1; k < boundary.size(); ++k) {
-      const int a = boundary[k - 1], b = boundary[k];
-      if (mesh.point(VertexHandle(a)) != mesh.point(VertexHandle(b))) continue;
-      const Vec3& p = mesh.point(VertexHandle(b));
-      throw r.vertex_at.error(file, std::size_t(b),
-                              fmt::format("vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on "
-                                          "a boundary: a duplicated vertex cuts the surface open there; merge them",
-                                          a + 1, b + 1, p[0], p[1], p[2]));
     }
   }
 
@@ -336,6 +297,46 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
         mesh.interface(e) = 1;
         if (mesh.edge_ref(e) == 0) mesh.edge_ref(e) = kInterfaceRef;
       }
+    }
+  }
+
+  // Last (after the more specific checks above): every vertex is a corner. A stray one would
+  // stretch the bounding box, and with it every default size (relative to its diagonal), without
+  // being part of the surface. Refused rather than dropped: dropping it would renumber the
+  // vertices, and a .sol written for this mesh would no longer match.
+  {
+    std::vector<char> used(r.points.size(), 0);
+    for (const auto& tri : r.triangles)
+      for (auto i : tri) used[std::size_t(i)] = 1;
+    const auto unused = std::size_t(std::count(used.begin(), used.end(), 0));
+    if (unused > 0) {
+      const auto first = std::size_t(std::find(used.begin(), used.end(), 0) - used.begin());
+      throw r.vertex_at.error(file, first,
+                              fmt::format("vertex {} is not a corner of any triangle ({} such vertices): it would "
+                                          "stretch the bounding box and so the default sizes; remove it",
+                                          first + 1, unused));
+    }
+  }
+  // Two boundary vertices at the same point: a vertex written twice, which cuts a closed surface
+  // open along the faces that use the copy (a boundary where there is none). Boundary vertices only:
+  // they are few, and a duplicate that opens nothing cannot lie anywhere else.
+  {
+    std::vector<int> boundary;
+    for (auto v : mesh.vertices())
+      if (mesh.is_boundary(v)) boundary.push_back(v.idx());
+    auto key = [&](int v) {
+      const Vec3& p = mesh.point(VertexHandle(v));
+      return std::array<double, 4>{p[0], p[1], p[2], double(v)};
+    };
+    std::sort(boundary.begin(), boundary.end(), [&](int a, int b) { return key(a) < key(b); });
+    for (std::size_t k = 1; k < boundary.size(); ++k) {
+      const int a = boundary[k - 1], b = boundary[k];
+      if (mesh.point(VertexHandle(a)) != mesh.point(VertexHandle(b))) continue;
+      const Vec3& p = mesh.point(VertexHandle(b));
+      throw r.vertex_at.error(file, std::size_t(b),
+                              fmt::format("vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on "
+                                          "a boundary: a duplicated vertex cuts the surface open there; merge them",
+                                          a + 1, b + 1, p[0], p[1], p[2]));
     }
   }
   return mesh;
