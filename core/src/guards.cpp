@@ -58,10 +58,7 @@ double faces_for_edge_length(double area, double h) { return area / (std::sqrt(3
 
 double estimate_remesh_faces(const SurfaceMesh& mesh, const RemeshOptions& options) {
   double hmax = options.hmax;
-  if (hmax == 0) {
-    double diagonal = bounding_box(mesh).diagonal();
-    hmax = (diagonal > 0 ? diagonal : 1) / 20;  // remesh()'s default
-  }
+  if (hmax == 0) hmax = resolution_length(mesh);  // remesh()'s default: about as many faces as the input
   if (!(hmax > 0)) return std::numeric_limits<double>::quiet_NaN();
   return faces_for_edge_length(total_area(mesh), hmax);
 }
