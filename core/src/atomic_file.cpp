@@ -1,11 +1,13 @@
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/fault_injection.hpp>
 
 #include <fmt/format.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <regex>
 #include <system_error>
 #include <unistd.h>
 
@@ -26,6 +28,7 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
       out.flush();
       if (!out) throw write_error(target, "write failed (disk full?)");
     }
+    fault_point("rename:" + target.filename().string());  // a crash between the write and the rename
     std::error_code ec;
     fs::rename(temp, target, ec);
     if (ec) throw write_error(target, "cannot rename the temporary file: " + ec.message());
@@ -34,6 +37,11 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
     fs::remove(temp, ignored);
     throw;
   }
+}
+
+bool is_atomic_temporary(const std::string& file_name) {
+  static const std::regex temporary(R"(\..+\.tmp[0-9]+-[0-9]+)");
+  return std::regex_match(file_name, temporary);
 }
 
 }  // namespace bodyfit

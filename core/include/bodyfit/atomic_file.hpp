@@ -11,4 +11,8 @@ namespace bodyfit {
 /// InputError naming `target` is thrown; `target` is never left half-written.
 void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write);
 
+/// Whether a file name is one of write_atomically's temporaries (".<target>.tmp<pid>-<n>"): one
+/// that exists when no write is in progress was left by a process killed during the write.
+bool is_atomic_temporary(const std::string& file_name);
+
 }  // namespace bodyfit

@@ -1,0 +1,26 @@
+#pragma once
+// Fault injection for tests: kill the process (SIGKILL, nothing flushed, nothing cleaned up) at a
+// named write point of a run, at a given iteration — a crash at a known point instead of a race
+// with a timer. `bodyfit run --inject-fault POINT:N` arms it (docs/running.md lists the points).
+//
+// A point is reached by the thread writing the outputs of an iteration; which iteration that is
+// is per thread (the run's loop, the background checkpoint writer), set with set_fault_iteration.
+// Unarmed, reaching a point is one relaxed atomic load.
+#include <string>
+#include <string_view>
+
+namespace bodyfit {
+
+/// Arm the one fault of this process from "POINT:ITERATION" (the point may itself contain ':',
+/// e.g. "rename:history.csv:3"). Throws InputError on a malformed specification.
+void arm_fault(const std::string& specification);
+/// The iteration whose outputs the calling thread is writing (thread-local; −1 before any).
+void set_fault_iteration(int iteration);
+int fault_iteration();
+/// Whether the armed fault is `point` at the calling thread's iteration (a point that needs
+/// preparing, e.g. waiting for a background write, prepares only then).
+bool fault_armed(std::string_view point);
+/// SIGKILL the process when the armed fault is `point` at the calling thread's iteration.
+void fault_point(std::string_view point);
+
+}  // namespace bodyfit
