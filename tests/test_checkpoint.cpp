@@ -71,14 +71,14 @@ std::string error_of(const std::string& bytes) {
   return "";
 }
 
-/// The same checkpoint as format 2 wrote it (no Δt, no model state, no checksum): what runs made
-/// before the step lifecycle left on disk.
-std::string as_format_2(const std::string& v3, bool had_model_state) {
+/// The same checkpoint as format 2 wrote it (no Δt, no model state, no case, no checksum): what
+/// runs made before the step lifecycle left on disk.
+std::string as_format_2(const std::string& v4, bool had_model_state) {
   REQUIRE(!had_model_state);
   std::string v2 = "BFCKPT02";
-  v2 += v3.substr(8, 16);    // iteration, time
-  v2 += v3.substr(32);       // counts and arrays (the Δt at 24..32 dropped)
-  v2.resize(v2.size() - 9);  // model-state flag and checksum
+  v2 += v4.substr(8, 16);     // iteration, time
+  v2 += v4.substr(32);        // counts and arrays (the Δt at 24..32 dropped)
+  v2.resize(v2.size() - 17);  // model-state flag, empty case record, checksum
   return v2;
 }
 
@@ -121,7 +121,8 @@ TEST_CASE("checkpoints round-trip the mesh, the run state and the model state bi
   state.set("raster", std::string("\0binary\xff", 8));
   state.set("empty", std::vector<double>{});
   const Checkpoint c = parse(bytes_of(mesh, {.iteration = 7, .time = 0.125, .dt = 0.0375}, &state));
-  CHECK(c.format == 3);
+  CHECK(c.format == 4);
+  CHECK(c.case_text.empty());  // none given
   CHECK(c.run.iteration == 7);
   CHECK(c.run.time == 0.125);
   CHECK(c.run.dt == 0.0375);
@@ -131,6 +132,12 @@ TEST_CASE("checkpoints round-trip the mesh, the run state and the model state bi
   CHECK(c.model->string("raster").size() == 8);
   check_same_arrays(c.mesh, mesh);
   CHECK(region_area(c.mesh, kInside) == region_area(mesh, kInside));
+
+  // The effective case a run records (format 4).
+  CheckpointSnapshot with_case;
+  take_snapshot(with_case, mesh, {.iteration = 2}, &state, "[time]\ndt = 0.5\n");
+  with_case.seal();
+  CHECK(parse(std::string(with_case.bytes())).case_text == "[time]\ndt = 0.5\n");
 
   // Without a model state, and the accessors' errors.
   CHECK_FALSE(parse(bytes_of(mesh, {}, nullptr)).model);

@@ -1,4 +1,4 @@
-// Checkpoint files (formats 1-3) and the canonical form of a mesh they read back.
+// Checkpoint files (formats 1-4) and the canonical form of a mesh they read back.
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/error.hpp>
@@ -21,10 +21,13 @@ namespace {
 // Version 1 stored the faces' corners (read back through add_face, whose cost dominated an
 // iteration's remesh stage at 200k faces); version 2 stores OpenMesh's connectivity arrays as they
 // are, so reading restores the exact mesh in O(n) and canonicalize() is cheap.
-// Version 3 adds the Δt in force, the model's state and a checksum.
+// Version 3 adds the Δt in force, the model's state and a checksum; version 4 the effective case.
 constexpr char kMagicV1[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '1'};
 constexpr char kMagicV2[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '2'};
 constexpr char kMagicV3[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '3'};
+constexpr char kMagicV4[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '4'};
+/// The largest effective case a checkpoint holds (a case file is a few kB).
+constexpr std::uint64_t kMaxCaseBytes = 1 << 24;
 
 // Bytes per element of the format-2/3 arrays: a vertex is 3 doubles + ref + 2 flags + φ + its
 // halfedge; an edge 2 × (vertex, next, face) + ref + 3 flags; a face its halfedge + region.
@@ -308,8 +311,9 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
   if (std::equal(magic, magic + 8, kMagicV1)) c.format = 1;
   else if (std::equal(magic, magic + 8, kMagicV2)) c.format = 2;
   else if (std::equal(magic, magic + 8, kMagicV3)) c.format = 3;
+  else if (std::equal(magic, magic + 8, kMagicV4)) c.format = 4;
   else throw InputError(fmt::format("{}: not a bodyfit checkpoint", name));
-  if (c.format >= 3) {
+  if (c.format >= 3) {  // the checksum first: nothing of a damaged file is trusted
     std::uint64_t stored = 0;
     if (data.size() >= 16) std::memcpy(&stored, data.data() + data.size() - 8, 8);
     if (data.size() < 16 || stored != checksum(data.data(), data.size() - 8))
@@ -328,6 +332,7 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
                                  nv, ne, nf, data.size()));
   c.mesh = c.format >= 2 ? read_v2(in, nv, ne, nf) : read_v1(in, nv, nf);
   if (c.format >= 3 && in.get<std::uint8_t>() == 1) c.model = get_model_state(in);
+  if (c.format >= 4) c.case_text = in.get_string(kMaxCaseBytes);
   return c;
 }
 
@@ -339,11 +344,13 @@ void CheckpointSnapshot::seal() {
   std::memcpy(data_.get() + size_ - 8, &sum, 8);
 }
 
-void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model) {
+void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model,
+                   std::string_view case_text) {
   if (has_deleted(mesh)) throw std::logic_error("take_snapshot: the mesh must be garbage-collected");
+  if (case_text.size() > kMaxCaseBytes) throw std::logic_error("take_snapshot: the case is too long to record");
   const std::size_t nv = mesh.n_vertices(), ne = mesh.n_edges(), nf = mesh.n_faces();
   const std::size_t size = 56 + kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf + 1 +
-                           (model ? model_state_size(*model) : 0) + 8;
+                           (model ? model_state_size(*model) : 0) + 8 + case_text.size() + 8;
   if (into.capacity_ < size) {
     into.data_.reset();  // free the old buffer before taking the larger one
     into.data_ = std::make_unique_for_overwrite<char[]>(size);
@@ -352,7 +359,7 @@ void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunS
   into.size_ = size;
   into.iteration_ = run.iteration;
   Writer out(into.data_.get());
-  out.put_raw(kMagicV3, sizeof kMagicV3);
+  out.put_raw(kMagicV4, sizeof kMagicV4);
   out.put<std::int64_t>(run.iteration);
   out.put<double>(run.time);
   out.put<double>(run.dt);
@@ -381,6 +388,8 @@ void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunS
   }
   out.put<std::uint8_t>(model ? 1 : 0);
   if (model) put_model_state(out, *model);
+  out.put<std::uint64_t>(case_text.size());
+  out.put_raw(case_text.data(), case_text.size());
   out.put<std::uint64_t>(0);  // the checksum, filled in by seal()
   if (out.at() != into.data_.get() + size) throw std::logic_error("take_snapshot: size mismatch");
 }

@@ -1,5 +1,7 @@
 #include <bodyfit/checkpoint_writer.hpp>
 
+#include <bodyfit/fault_injection.hpp>
+
 #include <spdlog/spdlog.h>
 
 #include <utility>
@@ -15,8 +17,8 @@ double ms_since(Clock::time_point start) {
 
 }  // namespace
 
-CheckpointWriter::CheckpointWriter(std::filesystem::path file, CheckpointCadence cadence)
-    : file_(std::move(file)), cadence_(cadence), last_snapshot_(Clock::now()) {}
+CheckpointWriter::CheckpointWriter(std::filesystem::path file, CheckpointCadence cadence, std::string case_text)
+    : file_(std::move(file)), cadence_(cadence), case_text_(std::move(case_text)), last_snapshot_(Clock::now()) {}
 
 CheckpointWriter::~CheckpointWriter() {
   try {
@@ -36,7 +38,7 @@ double CheckpointWriter::snapshot(const SurfaceMesh& mesh, const RunState& run, 
   const auto start = Clock::now();
   const double waited = wait();
   const auto copy = Clock::now();
-  take_snapshot(snapshot_, mesh, run, model);
+  take_snapshot(snapshot_, mesh, run, model, case_text_);
   last_snapshot_ = Clock::now();
   last_iteration_ = run.iteration;
   const double total = ms_since(start);
@@ -50,6 +52,7 @@ void CheckpointWriter::start() {
   wait();
   if (snapshot_.bytes().empty()) return;  // nothing taken yet
   worker_ = std::thread([this] {
+    set_fault_iteration(snapshot_.iteration());  // this thread writes that iteration's checkpoint
     try {
       const auto start = Clock::now();
       save_checkpoint(file_, snapshot_);

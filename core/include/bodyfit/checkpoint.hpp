@@ -4,8 +4,10 @@
 // from which `bodyfit run --resume` continues exactly as the uninterrupted run would have.
 //
 // Doubles are stored bit-exactly and OpenMesh's connectivity arrays as they are, so reading restores
-// the very arrays that were written. Format 3 (this one) adds the Δt in force, the model state and a
-// checksum over everything before it; formats 1 and 2 are still read (then there is no model state).
+// the very arrays that were written. Format 3 added the Δt in force, the model state and a checksum
+// over everything before it; format 4 (this one) the effective case the run was started with
+// (case_identity.hpp), which --resume compares with its own. Formats 1-3 are still read (then there
+// is no case record; formats 1 and 2 have no model state either).
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/model_state.hpp>
 
@@ -30,7 +32,8 @@ struct Checkpoint {
   SurfaceMesh mesh;
   RunState run;
   std::optional<ModelState> model;  ///< absent in formats 1 and 2
-  int format = 3;                   ///< the format the file was written in
+  std::string case_text;            ///< the effective case (canonical_case); empty: not recorded (formats 1-3)
+  int format = 4;                   ///< the format the file was written in
 };
 
 /// A checkpoint taken out of a live run: the arrays, the run state and the model state encoded in
@@ -45,15 +48,18 @@ class CheckpointSnapshot {
   void seal();
 
  private:
-  friend void take_snapshot(CheckpointSnapshot&, const SurfaceMesh&, const RunState&, const ModelState*);
+  friend void take_snapshot(CheckpointSnapshot&, const SurfaceMesh&, const RunState&, const ModelState*,
+                            std::string_view);
   std::unique_ptr<char[]> data_;
   std::size_t size_ = 0, capacity_ = 0;
   int iteration_ = -1;
 };
 
 /// Copy the state into `into` (one sequential pass over the arrays). The mesh must be
-/// garbage-collected; `model` may be null (no model state stored).
-void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model);
+/// garbage-collected; `model` may be null (no model state stored); `case_text` is the run's
+/// effective case (canonical_case; empty: none recorded).
+void take_snapshot(CheckpointSnapshot& into, const SurfaceMesh& mesh, const RunState& run, const ModelState* model,
+                   std::string_view case_text = {});
 /// Seal and write a snapshot atomically (temporary + rename), then fsync it and its directory.
 void save_checkpoint(const std::filesystem::path& file, CheckpointSnapshot& snapshot);
 

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <exception>
 #include <filesystem>
+#include <string>
 #include <thread>
 
 namespace bodyfit {
@@ -27,7 +28,8 @@ struct CheckpointCadence {
 
 class CheckpointWriter {
  public:
-  CheckpointWriter(std::filesystem::path file, CheckpointCadence cadence);
+  /// `case_text`: the run's effective case (canonical_case), recorded in every checkpoint.
+  CheckpointWriter(std::filesystem::path file, CheckpointCadence cadence, std::string case_text = {});
   /// Waits for the write in flight (an error there is logged: a destructor cannot throw).
   ~CheckpointWriter();
   CheckpointWriter(const CheckpointWriter&) = delete;
@@ -50,6 +52,7 @@ class CheckpointWriter {
  private:
   std::filesystem::path file_;
   CheckpointCadence cadence_;
+  std::string case_text_;
   CheckpointSnapshot snapshot_;
   std::thread worker_;
   std::exception_ptr error_;
