@@ -66,26 +66,10 @@ double metric(const IterationRecord& r, const std::string& name) {
   return 0;
 }
 
-/// history.csv without its wall-clock columns (ms_*), which no two runs share.
-std::string history_without_timings(const std::filesystem::path& file) {
-  std::stringstream in(test::read_file(file)), out;
-  std::vector<bool> keep;
-  for (std::string line; std::getline(in, line);) {
-    std::stringstream cells(line);
-    std::size_t c = 0;
-    for (std::string cell; std::getline(cells, cell, ','); ++c) {
-      if (keep.size() <= c) keep.push_back(cell.rfind("ms_", 0) != 0);  // from the header
-      if (keep[c]) out << cell << ',';
-    }
-    out << '\n';
-  }
-  return out.str();
-}
-
-/// A format-3 checkpoint rewritten as format 2 (before model states): what older runs left.
+/// A format-4 checkpoint rewritten as format 2 (before model states): what older runs left.
 void downgrade_checkpoint(const std::filesystem::path& file) {
   std::string v3 = test::read_file(file);
-  REQUIRE(v3.rfind("BFCKPT03", 0) == 0);
+  REQUIRE(v3.rfind("BFCKPT04", 0) == 0);  // the same header and arrays as format 3
   std::uint64_t nv, ne, nf;
   std::memcpy(&nv, v3.data() + 32, 8), std::memcpy(&ne, v3.data() + 40, 8), std::memcpy(&nf, v3.data() + 48, 8);
   const std::size_t arrays_end = 56 + 42 * nv + 31 * ne + 8 * nf;
@@ -174,9 +158,9 @@ TEST_CASE("model-driven Δt and model state survive a resume: the same steps as 
                                 " --resume");
   REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
   CHECK(rest.output.find("resuming from iteration 3") != std::string::npos);
-  const std::string a = history_without_timings(dir / "full" / "history.csv");
+  const std::string a = test::history_without_timings(dir / "full" / "history.csv");
   CHECK(a.find(",0.03125,") != std::string::npos);  // 0.025 · 1.25: the model grew Δt
-  CHECK(history_without_timings(dir / "part" / "history.csv") == a);
+  CHECK(test::history_without_timings(dir / "part" / "history.csv") == a);
   CHECK(test::read_file(dir / "part" / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
 
   // A checkpoint written before model states (format 2) still loads, with a warning.
@@ -206,11 +190,13 @@ TEST_CASE("a fire run interrupted by SIGINT or kill -9 and resumed ends byte-ide
     REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
     CHECK(test::read_file(out / "arrival_time.asc") == test::read_file(dir / "full" / "arrival_time.asc"));
     CHECK(test::read_file(out / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
-    CHECK(history_without_timings(out / "history.csv") == history_without_timings(dir / "full" / "history.csv"));
+    CHECK(test::history_without_timings(out / "history.csv") == test::history_without_timings(dir / "full" / "history.csv"));
   }
 }
 
 TEST_CASE("a model returning NaN velocities is an error naming the model and the iteration, not a wrong region") {
   CHECK_THROWS_WITH_AS(run("nan_at_vertex = 17"),
-                       doctest::Contains("model 'testlifecycle', iteration 0: non-finite velocity at vertex 17"), InputError);
+                       doctest::Contains("model 'testlifecycle' failed in compute at iteration 0: non-finite velocity "
+                                         "at vertex 17"),
+                       PluginError);
 }

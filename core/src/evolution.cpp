@@ -53,16 +53,17 @@ void velocity_into(const VelocityField& field, const StepContext& context, std::
   const bool tangential = field.kind == VelocityField::Kind::Tangential;
   const std::size_t given = tangential ? field.vector.size() : field.normal_speed.size();
   if (given != n)
-    throw InputError(fmt::format("model '{}': {} {} for {} vertices", model, given,
-                                 tangential ? "velocities" : "normal speeds", n));
+    throw PluginError(fmt::format("model '{}' failed in compute at iteration {}: {} {} for {} vertices", model,
+                                  context.iteration(), given, tangential ? "velocities" : "normal speeds", n));
   const VectorField* conormal = tangential ? nullptr : &context.conormal();
   velocity.resize(n);
   auto set = [&](std::size_t i) {
     const Vec3 v = tangential ? field.vector[i] : field.normal_speed[i] * (*conormal)[i];
     // A NaN would pass through the advection and the cut silently and give a wrong region.
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-      throw InputError(fmt::format("model '{}', iteration {}: non-finite velocity at vertex {} ({}, {}, {})", model,
-                                   context.iteration(), i, v[0], v[1], v[2]));
+      throw PluginError(fmt::format("model '{}' failed in compute at iteration {}: non-finite velocity at vertex {} "
+                                    "({}, {}, {})",
+                                    model, context.iteration(), i, v[0], v[1], v[2]));
     velocity[i] = v;
   };
   if (where.empty())
@@ -101,9 +102,14 @@ class Evolution {
         n_(start.iteration), t_(start.time), dt_(start.dt > 0 ? start.dt : options.dt) {}
 
   EvolutionResult run() {
-    measure_distance();
-    while (!should_stop()) advance();
-    return finish();
+    try {
+      measure_distance();
+      while (!should_stop()) advance();
+      return finish();
+    } catch (...) {
+      failed();
+      throw;
+    }
   }
 
  private:
@@ -136,15 +142,17 @@ class Evolution {
       const double dt = step / std::ldexp(1.0, attempt);
       LevelSetStep level_set = level_set_step(dt, attempt);  // 2.
       cut_and_remesh(level_set);                             // 3. T^n is now the candidate
-      Review review = review_candidate(level_set, attempt);  // 4.
+      Review review = review_or_restore(level_set, attempt, kept_mesh, kept_distance);  // 4.
       if (review.accepted()) {                               // 5.
         accept(level_set, std::move(review), step, attempt);
         return;
       }
       if (!kept_mesh)
-        throw InputError(fmt::format("model '{}' rejected a step but did not declare ModelNeeds::may_reject",
-                                     model_.name()));
+        throw PluginError(fmt::format("model '{}' failed in review at iteration {}: rejected a step but did not "
+                                      "declare ModelNeeds::may_reject",
+                                      model_.name(), n_ + 1));
       mesh_ = *kept_mesh;  // restore T^n exactly
+      candidate_ = false;
       distance_ = kept_distance;
       solver_.reset();  // built on the candidate
       if (hooks_.log)
@@ -303,7 +311,9 @@ class Evolution {
     else
       for (int i : band) vmax = std::max(vmax, velocity[i].norm());
     if (!std::isfinite(vmax))
-      throw InputError(fmt::format("model '{}': non-finite velocity (max_cfl cannot size the sub-steps)", model_.name()));
+      throw PluginError(fmt::format("model '{}' failed in compute at iteration {}: non-finite velocity (max_cfl cannot "
+                                    "size the sub-steps)",
+                                    model_.name(), n_));
     const double ratio = vmax * remaining / (options_.max_cfl * cfl_length());
     return ratio > 1 + 1e-9 ? remaining / std::ceil(ratio - 1e-9) : remaining;  // 3.0000000000000004 is 3
   }
@@ -312,6 +322,7 @@ class Evolution {
 
   // ---- 3. cut and remesh: the candidate T^{n+1} -------------------------------------------------
   void cut_and_remesh(LevelSetStep& step) {
+    candidate_ = true;  // from here on the mesh is no longer T^n
     solver_.reset();  // T^n's, and memory the remesh can use
     Stopwatch clock;
     discretize(mesh_, step.phi_next, options_.discretize);
@@ -324,16 +335,31 @@ class Evolution {
   }
 
   // ---- 4. the model's review ---------------------------------------------------------------------
+  /// The review; when it throws, T^n is restored if it was kept (the caller may then save it).
+  Review review_or_restore(LevelSetStep& step, int attempt, const std::optional<SurfaceMesh>& kept_mesh,
+                           const ScalarField& kept_distance) {
+    try {
+      return review_candidate(step, attempt);
+    } catch (...) {
+      if (kept_mesh) mesh_ = *kept_mesh, distance_ = kept_distance, candidate_ = false;
+      throw;
+    }
+  }
+
   Review review_candidate(LevelSetStep& step, int attempt) {
     Stopwatch clock;
     const StepContext candidate = context_for(mesh_, distance_, n_ + 1, t_ + step.done, step.done);
     Review review = model_.review(candidate, attempt);
     step.ms.review += clock.lap_ms();
+    if (!(std::isfinite(review.next_dt) && review.next_dt >= 0))  // inf would end the run in one step
+      throw PluginError(fmt::format("model '{}' failed in review at iteration {}: next Δt {} (expected a finite value ≥ 0)",
+                                    model_.name(), n_ + 1, review.next_dt));
     return review;
   }
 
   // ---- 5. accept: record, outputs, checkpoint ----------------------------------------------------
   void accept(const LevelSetStep& step, Review review, double nominal_dt, int attempt) {
+    candidate_ = false;  // T^{n+1} is the state now
     ++n_;
     t_ += step.done;
     if (review.next_dt > 0) dt_ = review.next_dt;
@@ -369,8 +395,19 @@ class Evolution {
       }
       hooks_.on_state(StateView{mesh_, n_, t_, distance_, field ? &velocity : nullptr, field ? &*field : nullptr, true});
     }
+    if (hooks_.on_end) hooks_.on_end(mesh_, result_);  // before finish(): a failing finish() loses nothing
     model_.finish(options_.output_dir);
     return std::move(result_);
+  }
+
+  /// An exception is leaving the loop: while the mesh is still the state n_, the caller may save it.
+  void failed() const {
+    if (candidate_ || !hooks_.on_failure) return;
+    try {
+      hooks_.on_failure(mesh_, RunState{n_, t_, dt_});
+    } catch (const std::exception& e) {
+      spdlog::error("while saving the last completed iteration after a failure: {}", e.what());
+    }
   }
 
   // ---- helpers ---------------------------------------------------------------------------------
@@ -420,6 +457,7 @@ class Evolution {
   VelocityField state_field_;   ///< the model's answer on T^n (first sub-step of the first attempt)
   VectorField state_velocity_;  ///< V^n
   int rejections_ = 0;          ///< of the current step
+  bool candidate_ = false;      ///< mesh_ is a candidate T^{n+1} (cut or remeshed, not yet accepted)
   bool stopped_ = false;
   EvolutionResult result_;
 };

@@ -205,12 +205,16 @@ LoadedModel load_model(std::string_view name) {
 }
 
 void configure_model(LoadedModel& model, const toml::table& parameters) {
+  const std::string where = model.file().string();
   try {
     model->configure(parameters);
-  } catch (const std::exception& e) {
+  } catch (const InputError& e) {
     throw file_error(model.file(), fmt::format("configure failed: {}", e.what()));
+  } catch (const std::exception& e) {
+    throw PluginError(fmt::format("{}: model '{}' failed in configure: {}", where, model->name(), e.what()));
   } catch (...) {
-    throw file_error(model.file(), "configure failed with an unknown exception");
+    throw PluginError(fmt::format("{}: model '{}' failed in configure: an exception that is not a std::exception", where,
+                                  model->name()));
   }
 }
 

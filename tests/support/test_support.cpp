@@ -32,6 +32,21 @@ std::string read_file(const std::filesystem::path& file) {
   return bytes.str();
 }
 
+std::string history_without_timings(const std::filesystem::path& file) {
+  std::stringstream in(read_file(file)), out;
+  std::vector<bool> keep;
+  for (std::string line; std::getline(in, line);) {
+    std::stringstream cells(line);
+    std::size_t c = 0;
+    for (std::string cell; std::getline(cells, cell, ','); ++c) {
+      if (keep.size() <= c) keep.push_back(cell.rfind("ms_", 0) != 0);  // from the header
+      if (keep[c]) out << cell << ',';
+    }
+    out << '\n';
+  }
+  return out.str();
+}
+
 CommandResult run_bodyfit(const std::string& arguments) {
   std::string command = std::string("\"") + BODYFIT_EXE + "\" " + arguments + " 2>&1";
   CommandResult result;

@@ -37,6 +37,9 @@ SurfaceMesh grid_square(int n, const GridSquare& options = {});
 /// The bytes of a file ("" when it cannot be read).
 std::string read_file(const std::filesystem::path& file);
 
+/// history.csv without its wall-clock columns (ms_*), which no two runs share.
+std::string history_without_timings(const std::filesystem::path& file);
+
 /// Path of a file in the source tree (e.g. "meshes/cube.mesh").
 std::filesystem::path source_path(const std::string& relative);
 

@@ -109,6 +109,8 @@ struct EvolutionOptions {
   bool canonical_order = true;
 };
 
+struct EvolutionResult;
+
 /// What the caller observes and controls while a run goes on.
 struct EvolutionHooks {
   bool log = true;               ///< one spdlog info line per iteration (and per rejected step)
@@ -118,6 +120,15 @@ struct EvolutionHooks {
   /// Called after every accepted step with T^{n+1}, its record and where the run stands (for the
   /// history and the checkpoint: RunState::dt is the Δt of the next step).
   std::function<void(const SurfaceMesh&, const IterationRecord&, const RunState&)> on_iteration;
+  /// Called once when the run has stopped (whatever the reason), with the final state and the
+  /// result, after its on_state and before the model's finish(): final outputs written here are on
+  /// disk even when finish() fails.
+  std::function<void(const SurfaceMesh&, const EvolutionResult&)> on_end;
+  /// Called when an exception is about to leave evolve() while the mesh is still an accepted state
+  /// (a failure in the model's compute, end_step or finish, in the advection or in an output
+  /// hook), with where the run stands: the caller may checkpoint it. Not called when the mesh is a
+  /// candidate (a failure in the cut, the remesh or the review). Its own exceptions are logged.
+  std::function<void(const SurfaceMesh&, const RunState&)> on_failure;
 
   /// No log, no callbacks (tests, benchmarks).
   static EvolutionHooks quiet() {

@@ -57,8 +57,9 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures = nu
 /// contains a '/' or ends in .so.
 LoadedModel load_model(std::string_view name);
 LoadedModel load_plugin_file(const std::filesystem::path& file);
-/// Call model.configure(parameters); any exception becomes InputError
-/// "<file>: configure failed: <reason>".
+/// Call model.configure(parameters). An InputError (the documented way to refuse a parameter)
+/// becomes InputError "<file>: configure failed: <reason>"; any other exception PluginError
+/// "<file>: model '<name>' failed in configure: <reason>".
 void configure_model(LoadedModel& model, const toml::table& parameters);
 /// Decode kPluginAbi-style numbers: "1.0".
 std::string abi_string(std::uint32_t abi);

@@ -1,0 +1,156 @@
+#include <bodyfit/error.hpp>
+#include <bodyfit/model_guard.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <cstring>
+#include <vector>
+
+#include <unistd.h>
+
+namespace bodyfit {
+namespace {
+
+// What the crash handler reads: plain data and lock-free atomics (async-signal-safe).
+char g_model[128] = "?";
+std::atomic<const char*> g_stage{nullptr};
+std::atomic<int> g_iteration{-1};
+
+void put(char*& at, const char* end, const char* text) {
+  while (*text && at < end) *at++ = *text++;
+}
+
+void put_int(char*& at, const char* end, int value) {
+  char digits[16];
+  int n = 0;
+  unsigned u = value < 0 ? 0u - unsigned(value) : unsigned(value);
+  do digits[n++] = char('0' + u % 10), u /= 10;
+  while (u && n < 15);
+  if (value < 0 && at < end) *at++ = '-';
+  while (n && at < end) *at++ = digits[--n];
+}
+
+const char* signal_name(int signal) {
+  switch (signal) {
+    case SIGSEGV: return "SIGSEGV";
+    case SIGBUS: return "SIGBUS";
+    case SIGFPE: return "SIGFPE";
+    case SIGILL: return "SIGILL";
+    case SIGABRT: return "SIGABRT";
+  }
+  return "a signal";
+}
+
+extern "C" void on_crash(int signal) {
+  // SA_RESETHAND: the default action is back; re-raised below, the process dies of the signal.
+  const char* stage = g_stage.load();
+  if (stage) {
+    char message[512];
+    char* at = message;
+    const char* end = message + sizeof message - 1;
+    put(at, end, "bodyfit: model '");
+    put(at, end, g_model);
+    put(at, end, "' crashed (");
+    put(at, end, signal_name(signal));
+    put(at, end, ") in ");
+    put(at, end, stage);
+    const int iteration = g_iteration.load();
+    if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
+    put(at, end, "; the checkpoint on disk is intact: --resume continues from it\n");
+    [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+  }
+  std::raise(signal);  // a raised (not faulting) signal would otherwise return here
+}
+
+std::string message_of(std::exception_ptr error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "an exception that is not a std::exception";
+  }
+}
+
+}  // namespace
+
+void report_model_crashes(const std::string& name) {
+  const std::size_t n = std::min(name.size(), sizeof g_model - 1);
+  std::memcpy(g_model, name.data(), n);
+  g_model[n] = '\0';
+  static const bool installed = [] {
+    // Its own stack, so that a stack overflow in the model is reported too.
+    static std::vector<char> stack(std::size_t(std::max<long>(SIGSTKSZ, 64 * 1024)));
+    stack_t alternate{};
+    alternate.ss_sp = stack.data();
+    alternate.ss_size = stack.size();
+    ::sigaltstack(&alternate, nullptr);
+    struct sigaction action {};
+    action.sa_handler = on_crash;
+    action.sa_flags = SA_RESETHAND | SA_NODEFER | SA_ONSTACK;
+    sigemptyset(&action.sa_mask);
+    for (int signal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::sigaction(signal, &action, nullptr);
+    return true;
+  }();
+  (void)installed;
+}
+
+PluginCall::PluginCall(const char* stage, int iteration) {
+  g_iteration.store(iteration);
+  g_stage.store(stage);
+}
+
+PluginCall::~PluginCall() { g_stage.store(nullptr); }
+
+GuardedModel::GuardedModel(VelocityModel& model, int iteration)
+    : model_(model), name_(model.name()), iteration_(iteration), step_(iteration) {}
+
+template <class Call>
+auto GuardedModel::guarded(const char* stage, int iteration, Call&& call) const -> decltype(call()) {
+  PluginCall marked(stage, iteration);
+  try {
+    return call();
+  } catch (...) {
+    const std::string where = iteration >= 0 ? fmt::format(" at iteration {}", iteration) : std::string();
+    throw PluginError(fmt::format("model '{}' failed in {}{}: {}", name_, stage, where, message_of(std::current_exception())));
+  }
+}
+
+void GuardedModel::configure(const toml::table& parameters) {
+  guarded("configure", -1, [&] { model_.configure(parameters); });
+}
+
+ModelNeeds GuardedModel::needs() const {
+  return guarded("needs", iteration_, [&] { return model_.needs(); });
+}
+
+VelocityField GuardedModel::compute(const StepContext& context) {
+  iteration_ = step_ = context.iteration();
+  return guarded("compute", step_, [&] { return model_.compute(context); });
+}
+
+void GuardedModel::end_step(const StepOutcome& outcome) {
+  guarded("end_step", step_, [&] { model_.end_step(outcome); });
+}
+
+Review GuardedModel::review(const StepContext& candidate, int attempt) {
+  iteration_ = candidate.iteration();
+  return guarded("review", iteration_, [&] { return model_.review(candidate, attempt); });
+}
+
+void GuardedModel::save_state(ModelState& state) const {
+  guarded("save_state", iteration_, [&] { model_.save_state(state); });
+}
+
+void GuardedModel::load_state(const ModelState& state) {
+  guarded("load_state", iteration_, [&] { model_.load_state(state); });
+}
+
+void GuardedModel::finish(const std::filesystem::path& output_dir) {
+  guarded("finish", iteration_, [&] { model_.finish(output_dir); });
+}
+
+}  // namespace bodyfit

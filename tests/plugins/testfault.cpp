@@ -1,0 +1,89 @@
+// A test model that fails on request: constant normal speed, and at one stage of one iteration it
+// throws (a std::runtime_error, an InputError, an int), crashes (SIGSEGV, SIGFPE) or returns a
+// broken field (a NaN, the wrong size). Its state (the iteration reached, the computes made) goes
+// through the checkpoint, so that save_state and load_state can fail too.
+#include <bodyfit/error.hpp>
+#include <bodyfit/parameters.hpp>
+#include <bodyfit/velocity_model.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+namespace {
+
+using namespace bodyfit;
+
+class FaultModel final : public VelocityModel {
+ public:
+  std::string_view name() const override { return "testfault"; }
+  void configure(const toml::table& table) override {
+    Parameters p(table, "model");
+    speed_ = p.number("speed", 1.0);
+    stage_ = p.choice("stage", "none",
+                      {"none", "configure", "compute", "end_step", "review", "save_state", "load_state", "finish"});
+    at_ = p.integer("at", 0, 0);
+    how_ = p.choice("how", "runtime_error", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size"});
+    p.reject_unknown();
+    if (stage_ == "configure") fail();
+  }
+
+  VelocityField compute(const StepContext& context) override {
+    step_ = context.iteration();
+    ++computes_;
+    auto field = VelocityField::normal(ScalarField(context.mesh().n_vertices(), speed_));
+    if (stage_ == "compute" && step_ == at_) {
+      if (how_ == "not_finite") field.normal_speed[field.normal_speed.size() / 2] = std::nan("");
+      else if (how_ == "size") field.normal_speed.pop_back();
+      else fail();
+    }
+    return field;
+  }
+  void end_step(const StepOutcome&) override {
+    if (stage_ == "end_step" && step_ == at_) fail();
+  }
+  Review review(const StepContext& candidate, int) override {
+    if (stage_ == "review" && candidate.iteration() == at_) fail();
+    state_ = candidate.iteration();
+    return Review::accept();
+  }
+  void save_state(ModelState& state) const override {
+    if (stage_ == "save_state" && state_ == at_) fail();
+    state.version = 1;
+    state.set("state", std::vector<std::int64_t>{state_, computes_});
+  }
+  void load_state(const ModelState& state) override {
+    const auto& values = state.integers("state");
+    state_ = values.at(0), computes_ = values.at(1);
+    if (stage_ == "load_state" && state_ == at_) fail();
+  }
+  void finish(const std::filesystem::path&) override {
+    if (stage_ == "finish" && state_ == at_) fail();
+  }
+
+ private:
+  [[noreturn]] void fail() const {
+    if (how_ == "input_error") throw InputError("an input error from " + stage_);
+    if (how_ == "int") throw 42;
+    if (how_ == "segv") {
+      int* volatile nowhere = nullptr;  // volatile: the compiler cannot see the null
+      *nowhere = 1;
+    }
+    if (how_ == "fpe") {
+      volatile int zero = 0;
+      volatile int one = 1;
+      one = one / zero;
+    }
+    throw std::runtime_error("a runtime error from " + stage_);
+  }
+
+  double speed_ = 1;
+  std::string stage_ = "none", how_;
+  std::int64_t at_ = 0;
+  int step_ = -1;
+  std::int64_t state_ = 0, computes_ = 0;
+};
+
+}  // namespace
+
+BODYFIT_PLUGIN(FaultModel)
