@@ -7,5 +7,5 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$ROOT/scripts/setup.sh"
 "$ROOT/scripts/build.sh"
 BUILD="${BODYFIT_BUILD_DIR:-$ROOT/build}"
-"$BUILD/bin/bodyfit" run "$ROOT/meshes/cases/sphere_cap.toml" -o "$ROOT/out/sphere_cap"
+"$BUILD/bin/bodyfit" run "$ROOT/meshes/cases/sphere_cap.toml" -o "$ROOT/out/sphere_cap" --overwrite
 echo "example done: see $ROOT/out/sphere_cap/ (series.pvd, *.png, history.csv)"

@@ -1,0 +1,335 @@
+// Runs that fail, and what they leave: a run killed at every write point (--inject-fault) and
+// resumed ends with the outputs of the uninterrupted run, byte for byte; a model failing at any
+// stage exits with code 4 naming the model, the stage and the iteration, and the run resumes;
+// output directories (a previous run is refused unless --overwrite or --resume; a failed set-up
+// leaves nothing); --resume with another case is refused unless --force.
+#include <bodyfit/case_identity.hpp>
+#include <bodyfit/checkpoint.hpp>
+#include <bodyfit/run_directory.hpp>
+
+#include "test_support.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+
+using namespace bodyfit;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fire on a small procedural terrain, 5 steps of which the last is shortened (200 s of 600),
+// every output on: a VTU per state, a checkpoint per iteration, the arrival-time raster.
+const char* kFire = R"(
+[surface]
+generator = "terrain"
+extent = 6000.0
+h = 400.0
+seed = 7
+max_height = 600.0
+feature_size = 2000.0
+[region]
+shape = "disks"
+centers = [[3000.0, 3000.0]]
+radii = [1000.0]
+[model]
+name = "fire"
+preset = "balbi2009"
+[model.arrival]
+cell_size = 200.0
+[time]
+dt = 600.0
+final_time = 2600.0
+[remesh]
+hmax = 400.0
+[output]
+vtu_every = 1
+png_every = 0
+checkpoint_every = 1
+checkpoint_seconds = 0
+)";
+
+// A disk growing on a plane under the fault model (tests/plugins/testfault.cpp), 4 iterations,
+// checkpoints only at the start and the end (and those a failure writes).
+const char* kPlane = R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.1
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.3]
+[model]
+name = "testfault"
+speed = 0.5
+[time]
+dt = 0.05
+iterations = 4
+[remesh]
+hmax = 0.1
+[output]
+vtu_every = 0
+png_every = 0
+checkpoint_every = 0
+checkpoint_seconds = 0
+)";
+
+struct Case {
+  test::TempDir dir;
+  fs::path file;
+  Case(const std::string& name, const char* text) : dir(name), file(dir / "case.toml") {
+    std::ofstream(file) << text;
+    ::setenv("BODYFIT_PLUGIN_PATH", BODYFIT_TEST_PLUGIN_DIR, 1);
+  }
+  test::CommandResult run(const std::string& out, const std::string& arguments = "") const {
+    return test::run_bodyfit("run " + file.string() + " -o " + (dir / out).string() + " " + arguments);
+  }
+  int checkpointed(const std::string& out) const { return load_checkpoint(dir / out / "checkpoint.bin").run.iteration; }
+};
+
+std::vector<std::string> names_in(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+/// Every file of `dir` as in `reference`, byte for byte (history.csv but for its ms_* columns).
+void check_same_outputs(const fs::path& dir, const fs::path& reference) {
+  REQUIRE(names_in(dir) == names_in(reference));
+  for (const auto& name : names_in(reference)) {
+    CAPTURE(name);
+    if (name == "history.csv")
+      CHECK(test::history_without_timings(dir / name) == test::history_without_timings(reference / name));
+    else
+      CHECK(test::read_file(dir / name) == test::read_file(reference / name));
+  }
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("killed at every write point and resumed: every output byte-identical to the uninterrupted run") {
+  Case fire("faults_kill", kFire);
+  auto full = fire.run("full");
+  REQUIRE_MESSAGE(full.exit_code == 0, full.output);
+  REQUIRE(fire.checkpointed("full") == 5);
+  // The driver's points (between two files), then every atomic write between its temporary and
+  // the rename: the checkpoint (written in the background), the history, the .pvd, a VTU, the final
+  // mesh and φ, the model's raster, the effective case.
+  const std::vector<std::string> points = {
+      "checkpoint:0",  // the first checkpoint on disk, history.csv not yet
+      "row:2",         // a history row without its checkpoint
+      "checkpoint:2",  "vtu:2",  // a VTU without its .pvd entry
+      "pvd:2",         "final:5", "final-sol:5", "finish:5",  // before final.mesh, between it and
+                                                             // final.sol, before the model's finish
+      "rename:checkpoint.bin:0", "rename:checkpoint.bin:3", "rename:history.csv:1", "rename:history.csv:3",
+      "rename:series.pvd:0",     "rename:series.pvd:4",     "rename:step_00003.vtu:3",
+      "rename:final.mesh:5",     "rename:final.sol:5",      "rename:arrival_time.asc:5",
+      "rename:case.toml:0"};
+  for (const std::string& point : points) {
+    CAPTURE(point);
+    std::string out = "kill-" + point;
+    std::replace(out.begin(), out.end(), ':', '-');
+    auto killed = fire.run(out, "--inject-fault " + point);
+    REQUIRE_MESSAGE(killed.exit_code == 128 + 9, killed.output);  // the point was reached
+    const auto left = names_in(fire.dir / out);
+    if (point == "checkpoint:0") CHECK(left == std::vector<std::string>{"checkpoint.bin"});  // no history.csv yet
+    if (point.starts_with("rename:"))
+      CHECK(std::any_of(left.begin(), left.end(), [](const std::string& n) { return is_run_output(n) && n[0] == '.'; }));
+    // Killed before its first checkpoint, a run left only a temporary: it starts again (and
+    // removes it); from the first checkpoint on, it resumes.
+    const bool started = fs::exists(fire.dir / out / "checkpoint.bin");
+    CHECK(started == (point != "rename:checkpoint.bin:0"));
+    auto resumed = fire.run(out, started ? "--resume" : "");
+    REQUIRE_MESSAGE(resumed.exit_code == 0, resumed.output);
+    check_same_outputs(fire.dir / out, fire.dir / "full");
+  }
+  // A finished run resumed (its last step shortened): nothing recomputed, nothing dropped.
+  auto again = fire.run("full", "--resume");
+  REQUIRE_MESSAGE(again.exit_code == 0, again.output);
+  CHECK(contains(test::read_file(fire.dir / "full" / "series.pvd"), "timestep=\"2400\""));
+  const auto names = names_in(fire.dir / "full");
+  CHECK(std::count(names.begin(), names.end(), "step_00004.vtu") == 1);
+}
+
+TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and the iteration; the run resumes") {
+  Case plane("faults_plugin", kPlane);
+  auto reference = plane.run("reference");
+  REQUIRE_MESSAGE(reference.exit_code == 0, reference.output);
+  struct Fault {
+    std::string settings, message;
+    int exit_code, checkpoint;  ///< the checkpoint the failed run leaves
+  };
+  const std::vector<Fault> faults = {
+      {"stage=compute at=2 how=runtime_error", "failed in compute at iteration 2: a runtime error from compute", 4, 2},
+      {"stage=compute at=2 how=int", "failed in compute at iteration 2: an exception that is not a std::exception", 4, 2},
+      {"stage=compute at=2 how=input_error", "failed in compute at iteration 2: an input error from compute", 4, 2},
+      {"stage=compute at=2 how=not_finite", "failed in compute at iteration 2: non-finite velocity at vertex", 4, 2},
+      {"stage=compute at=2 how=size", "failed in compute at iteration 2: ", 4, 2},
+      {"stage=end_step at=2", "failed in end_step at iteration 2: a runtime error from end_step", 4, 2},
+      // The candidate T^3 is in memory, not T^2: the last checkpoint written stands.
+      {"stage=review at=3", "failed in review at iteration 3: a runtime error from review", 4, 0},
+      {"stage=save_state at=2", "failed in save_state at iteration 2: a runtime error from save_state", 4, 0},
+      {"stage=finish at=4", "failed in finish at iteration 4: a runtime error from finish", 4, 4},
+      {"stage=compute at=2 how=segv", "model 'testfault' crashed (SIGSEGV) in compute at iteration 2", 128 + 11, 0},
+      {"stage=compute at=2 how=fpe", "model 'testfault' crashed (SIGFPE) in compute at iteration 2", 128 + 8, 0},
+  };
+  for (const Fault& fault : faults) {
+    CAPTURE(fault.settings);
+    std::string sets, out = "fault";
+    std::stringstream words(fault.settings);
+    for (std::string word; words >> word;) sets += " --set model." + word, out += "-" + word;
+    std::replace(out.begin(), out.end(), '=', '-');
+    auto failed = plane.run(out, sets);
+    CHECK_MESSAGE(failed.exit_code == fault.exit_code, failed.output);
+    CHECK_MESSAGE(contains(failed.output, fault.message), failed.output);
+    if (fault.exit_code == 4) CHECK(contains(failed.output, "model 'testfault' failed in "));
+    CHECK(plane.checkpointed(out) == fault.checkpoint);
+    if (fault.settings.starts_with("stage=finish")) {  // the completed run's final mesh is on disk
+      CHECK(test::read_file(plane.dir / out / "final.mesh") == test::read_file(plane.dir / "reference" / "final.mesh"));
+    }
+    auto resumed = plane.run(out, sets + " --set model.stage=none --resume --force");
+    REQUIRE_MESSAGE(resumed.exit_code == 0, resumed.output);
+    CHECK(test::read_file(plane.dir / out / "final.mesh") == test::read_file(plane.dir / "reference" / "final.mesh"));
+    CHECK(test::history_without_timings(plane.dir / out / "history.csv") ==
+          test::history_without_timings(plane.dir / "reference" / "history.csv"));
+  }
+
+  // load_state on --resume: nothing of the directory is touched.
+  auto part = plane.run("load", "--inject-signal 2:INT");
+  REQUIRE_MESSAGE(part.exit_code == 130, part.output);
+  const std::string history = test::read_file(plane.dir / "load" / "history.csv");
+  auto load = plane.run("load", "--set model.stage=load_state --set model.at=2 --resume --force");
+  CHECK_MESSAGE(load.exit_code == 4, load.output);
+  CHECK(contains(load.output, "model 'testfault' failed in load_state at iteration 2: a runtime error from load_state"));
+  CHECK(test::read_file(plane.dir / "load" / "history.csv") == history);
+
+  // configure: an InputError is the user's (exit 1), anything else the plugin's (exit 4).
+  auto input = plane.run("configure-input", "--set model.stage=configure --set model.how=input_error");
+  CHECK_MESSAGE(input.exit_code == 1, input.output);
+  CHECK(contains(input.output, "configure failed: an input error from configure"));
+  auto thrown = plane.run("configure-int", "--set model.stage=configure --set model.how=int");
+  CHECK_MESSAGE(thrown.exit_code == 4, thrown.output);
+  CHECK(contains(thrown.output, "model 'testfault' failed in configure: an exception that is not a std::exception"));
+  CHECK_FALSE(fs::exists(plane.dir / "configure-input"));
+  CHECK_FALSE(fs::exists(plane.dir / "configure-int"));
+}
+
+TEST_CASE("output directories: a previous run is refused unless --overwrite or --resume; a failed set-up leaves nothing") {
+  Case plane("faults_dirs", kPlane);
+  auto first = plane.run("out", "--set time.iterations=1");
+  REQUIRE_MESSAGE(first.exit_code == 0, first.output);
+  auto again = plane.run("out", "--set time.iterations=1");
+  CHECK(again.exit_code == 1);
+  CHECK(contains(again.output, "holds a previous run"));
+  CHECK(contains(again.output, "--overwrite"));
+
+  // --overwrite removes the run's files, and only those.
+  std::ofstream(plane.dir / "out" / "notes.txt") << "mine";
+  std::ofstream(plane.dir / "out" / "step_00099.vtu") << "an older run's";
+  std::ofstream(plane.dir / "out" / ".history.csv.tmp999-3") << "a killed write";
+  auto overwritten = plane.run("out", "--set time.iterations=2 --overwrite");
+  REQUIRE_MESSAGE(overwritten.exit_code == 0, overwritten.output);
+  CHECK(test::read_file(plane.dir / "out" / "notes.txt") == "mine");
+  CHECK_FALSE(fs::exists(plane.dir / "out" / "step_00099.vtu"));
+  CHECK_FALSE(fs::exists(plane.dir / "out" / ".history.csv.tmp999-3"));
+  CHECK(plane.checkpointed("out") == 2);
+  CHECK(plane.run("out", "--overwrite --resume").exit_code == 2);  // one or the other
+
+  // A failed set-up writes nothing: a bad key, an unknown model, a bad mesh, a failing configure.
+  std::ofstream(plane.dir / "bad.mesh") << "not a mesh at all\n";
+  std::ofstream(plane.dir / "bad_mesh.toml") << "[surface]\nfile = \"bad.mesh\"\n[region]\nshape = \"refs\"\n"
+                                                "[model]\nname = \"testfault\"\n[time]\ndt = 0.1\niterations = 1\n";
+  const std::vector<std::pair<std::string, std::string>> failures = {
+      {"run " + plane.file.string(), "--set time.tiem=3"},
+      {"run " + plane.file.string(), "--set model.name=nosuchmodel"},
+      {"run " + (plane.dir / "bad_mesh.toml").string(), ""},
+      {"run " + plane.file.string(), "--set model.stage=configure"}};
+  for (std::size_t i = 0; i < failures.size(); ++i) {
+    CAPTURE(failures[i].second);
+    const fs::path out = plane.dir / ("failed" + std::to_string(i));
+    auto failed = test::run_bodyfit(failures[i].first + " -o " + out.string() + " " + failures[i].second);
+    CHECK_MESSAGE(failed.exit_code != 0, failed.output);
+    CHECK_FALSE(fs::exists(out));
+  }
+}
+
+TEST_CASE("--resume with another case is refused, naming the keys, unless --force; the end of the run may change") {
+  Case plane("faults_case", kPlane);
+  auto first = plane.run("out", "--set time.iterations=2");
+  REQUIRE_MESSAGE(first.exit_code == 0, first.output);
+
+  auto other_dt = plane.run("out", "--set time.iterations=2 --set time.dt=0.025 --resume");
+  CHECK(other_dt.exit_code == 1);
+  CHECK_MESSAGE(contains(other_dt.output, "the case differs"), other_dt.output);
+  CHECK(contains(other_dt.output, "time.dt: 0.05 -> 0.025"));
+  CHECK(contains(other_dt.output, "--force"));
+  // Another case file: the same text but for the model's speed.
+  std::string text = kPlane;
+  text.replace(text.find("speed = 0.5"), 11, "speed = 0.7");
+  std::ofstream(plane.dir / "other.toml") << text;
+  auto other_file = test::run_bodyfit("run " + (plane.dir / "other.toml").string() + " -o " +
+                                      (plane.dir / "out").string() + " --set time.iterations=2 --resume");
+  CHECK(other_file.exit_code == 1);
+  CHECK_MESSAGE(contains(other_file.output, "model.speed: 0.5 -> 0.7"), other_file.output);
+
+  // Extending the run (more iterations) is not another case; --force accepts another one.
+  auto extended = plane.run("out", "--set time.iterations=3 --resume");
+  REQUIRE_MESSAGE(extended.exit_code == 0, extended.output);
+  CHECK(contains(extended.output, "resuming with time.iterations: 2 -> 3"));
+  auto forced = plane.run("out", "--set time.iterations=4 --set time.dt=0.025 --resume --force");
+  REQUIRE_MESSAGE(forced.exit_code == 0, forced.output);
+  CHECK(contains(forced.output, "--force"));
+
+  // A checkpoint that records no case (format 3, or written by a program): resumed, with a warning.
+  const Checkpoint c = load_checkpoint(plane.dir / "out" / "checkpoint.bin");
+  save_checkpoint(plane.dir / "out" / "checkpoint.bin", c.mesh, c.run, c.model ? &*c.model : nullptr);
+  auto unrecorded = plane.run("out", "--set time.iterations=5 --resume");
+  REQUIRE_MESSAGE(unrecorded.exit_code == 0, unrecorded.output);
+  CHECK(contains(unrecorded.output, "the case is not compared"));
+}
+
+TEST_CASE("case identity: canonical text, and the keys that differ") {
+  const std::string a = canonical_case(toml::parse("[time]\ndt = 0.5 # a comment\nfinal_time = 2.0\n[model]\nname = 'x'\n"));
+  const std::string b = canonical_case(toml::parse("[model]\nname = \"x\"\n\n[time]\nfinal_time = 2.0\ndt = 0.5\n"));
+  CHECK(a == b);
+  CHECK(case_changes(a, b).empty());
+  const std::string c = canonical_case(toml::parse("[model]\nname = 'y'\nspeed = 2\n[time]\nfinal_time = 2.0\n"));
+  const auto changes = case_changes(a, c);
+  REQUIRE(changes.size() == 3);
+  CHECK(changes[0].key == "model.name");
+  CHECK(changes[0].before == "'x'");
+  CHECK(changes[0].after == "'y'");
+  CHECK(changes[1].key == "model.speed");
+  CHECK(changes[1].before.empty());
+  CHECK(changes[2].key == "time.dt");
+  CHECK(changes[2].after.empty());
+  CHECK(resume_may_change("time.iterations"));
+  CHECK(resume_may_change("output.vtu_every"));
+  CHECK_FALSE(resume_may_change("time.dt"));
+  CHECK_FALSE(resume_may_change("model.speed"));
+}
+
+TEST_CASE("the run's own files: names, temporaries, per-state files past a checkpoint") {
+  CHECK(is_run_output("history.csv"));
+  CHECK(is_run_output("step_00012.vtu"));
+  CHECK(is_run_output("snap_00003.png"));
+  CHECK(is_run_output(".checkpoint.bin.tmp1234-0"));
+  CHECK_FALSE(is_run_output("notes.txt"));
+  CHECK_FALSE(is_run_output("arrival_time.asc"));  // the model's
+  CHECK_FALSE(is_run_output("step_final.vtu"));
+  test::TempDir dir("run_directory");
+  for (const char* name : {"step_00001.vtu", "step_00002.vtu", "snap_00002.png", "step_00003.vtu", "history.csv",
+                           ".series.pvd.tmp1-2", "mine.vtu"})
+    std::ofstream(dir / name) << "x";
+  CHECK(remove_stale_temporaries(dir.path()) == 1);
+  CHECK(remove_states_from(dir.path(), 2) == 3);
+  CHECK(names_in(dir.path()) == std::vector<std::string>{"history.csv", "mine.vtu", "step_00001.vtu"});
+  remove_run_outputs(dir.path());
+  CHECK(names_in(dir.path()) == std::vector<std::string>{"mine.vtu"});
+}
