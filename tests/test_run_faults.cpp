@@ -157,7 +157,7 @@ TEST_CASE("killed at every write point and resumed: every output byte-identical 
   CHECK(std::count(names.begin(), names.end(), "step_00004.vtu") == 1);
 }
 
-TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and the iteration; the run resumes") {
+TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and the iteration, and the run resumes") {
   Case plane("faults_plugin", kPlane);
   auto reference = plane.run("reference");
   REQUIRE_MESSAGE(reference.exit_code == 0, reference.output);
@@ -220,7 +220,7 @@ TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and 
   CHECK_FALSE(fs::exists(plane.dir / "configure-int"));
 }
 
-TEST_CASE("output directories: a previous run is refused unless --overwrite or --resume; a failed set-up leaves nothing") {
+TEST_CASE("output directories: a previous run is refused unless --overwrite or --resume, a failed set-up leaves nothing") {
   Case plane("faults_dirs", kPlane);
   auto first = plane.run("out", "--set time.iterations=1");
   REQUIRE_MESSAGE(first.exit_code == 0, first.output);
@@ -259,7 +259,7 @@ TEST_CASE("output directories: a previous run is refused unless --overwrite or -
   }
 }
 
-TEST_CASE("--resume with another case is refused, naming the keys, unless --force; the end of the run may change") {
+TEST_CASE("--resume with another case is refused, naming the keys, unless --force (the end of the run may change)") {
   Case plane("faults_case", kPlane);
   auto first = plane.run("out", "--set time.iterations=2");
   REQUIRE_MESSAGE(first.exit_code == 0, first.output);
