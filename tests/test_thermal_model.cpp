@@ -117,8 +117,10 @@ TEST_CASE("thermal optimisation on a sphere: J decreases at every accepted step,
 TEST_CASE("thermal model: bad input is a clear error") {
   bodyfit::test::TempDir dir("thermal_bad");
   const std::string case_file = write_case(dir, kSphere);
+  int runs = 0;  // a run failing in compute leaves a resumable run: each in its own directory
   auto run = [&](const std::string& extra) {
-    return bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "out").string() + " " + extra);
+    const std::string out = (dir / ("out" + std::to_string(runs++))).string();
+    return bodyfit::test::run_bodyfit("run " + case_file + " -o " + out + " " + extra);
   };
   // ε ≤ 0.
   auto zero = run("--set model.epsilon=0");

@@ -111,11 +111,16 @@ GuardedModel::GuardedModel(VelocityModel& model, int iteration)
 template <class Call>
 auto GuardedModel::guarded(const char* stage, int iteration, Call&& call) const -> decltype(call()) {
   PluginCall marked(stage, iteration);
+  auto message = [&] {
+    const std::string where = iteration >= 0 ? fmt::format(" at iteration {}", iteration) : std::string();
+    return fmt::format("model '{}' failed in {}{}: {}", name_, stage, where, message_of(std::current_exception()));
+  };
   try {
     return call();
+  } catch (const InputError&) {
+    throw InputError(message());  // the model says the user's input is wrong (an open surface…)
   } catch (...) {
-    const std::string where = iteration >= 0 ? fmt::format(" at iteration {}", iteration) : std::string();
-    throw PluginError(fmt::format("model '{}' failed in {}{}: {}", name_, stage, where, message_of(std::current_exception())));
+    throw PluginError(message());
   }
 }
 
