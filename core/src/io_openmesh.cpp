@@ -17,17 +17,18 @@ namespace bodyfit::io_detail {
 namespace {
 
 /// Collect what OpenMesh prints on omerr while in scope (instead of letting it reach stderr).
+/// omerr writes to std::cerr: its buffer is swapped for ours. (Not omerr().connect/disconnect:
+/// OpenMesh's disconnect never deletes the target that connect allocated, a leak per call.)
 class CaptureOpenMeshErrors {
  public:
   CaptureOpenMeshErrors() : log_was_enabled_(omlog().is_enabled()) {
-    was_on_cerr_ = omerr().disconnect(std::cerr);
-    omerr().connect(captured_);
+    omerr().flush();
+    cerr_buffer_ = std::cerr.rdbuf(captured_.rdbuf());
     omlog().disable();  // OpenMesh's writers log "[OBJWriter] : write file" on every call
   }
   ~CaptureOpenMeshErrors() {
     omerr().flush();
-    omerr().disconnect(captured_);
-    if (was_on_cerr_) omerr().connect(std::cerr);
+    std::cerr.rdbuf(cerr_buffer_);
     if (log_was_enabled_) omlog().enable();
   }
   CaptureOpenMeshErrors(const CaptureOpenMeshErrors&) = delete;
@@ -44,7 +45,7 @@ class CaptureOpenMeshErrors {
 
  private:
   std::ostringstream captured_;
-  bool was_on_cerr_ = false;
+  std::streambuf* cerr_buffer_ = nullptr;
   bool log_was_enabled_ = true;
 };
 
