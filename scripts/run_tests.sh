@@ -41,9 +41,10 @@ if want sanitize; then
   cmake --build "$SANITIZE_BUILD" -j "$JOBS"
   built=$SECONDS
   # Leaks are errors (the suppressions file lists what is left to system libraries, and why); a
-  # test under the sanitizers runs a few times slower: a longer timeout.
+  # single allocation above 2 GB is one too, as in the fuzzers (a count read from a file trusted
+  # before its length); a test under the sanitizers runs a few times slower: a longer timeout.
   (cd "$SANITIZE_BUILD" &&
-     ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_string_checks=1" \
+     ASAN_OPTIONS="detect_leaks=1:check_initialization_order=1:strict_string_checks=1:max_allocation_size_mb=2048" \
      LSAN_OPTIONS="suppressions=$ROOT/tests/sanitizers/lsan.supp:print_suppressions=0" \
      UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1" \
      ctest --output-on-failure -j "$JOBS" --timeout 1800)
