@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <iostream>
@@ -52,17 +53,23 @@ class CaptureOpenMeshErrors {
   bool log_was_enabled_ = true;
 };
 
-/// OpenMesh's OFF reader reserves the counts of the header before it reads a vertex (10^8 vertices
-/// announced in a 40-byte file asked for 9.6 GB; a negative count wrapped round to 4·10^9; found
-/// by fuzz_openmesh): counts the file cannot hold are refused first. A vertex takes 6 bytes or more
-/// ("0 0 0\n"; 12 in binary), a face 2 or more.
+/// OpenMesh's OFF reader trusts the numbers of the file (found by fuzz_openmesh): it reserves the
+/// header's counts before it reads a vertex (10^8 vertices announced in a 40-byte file asked for
+/// 9.6 GB; a negative count wraps round to 4·10^9), and it reads as many indices as a face's first
+/// number says, past the end of the file too (a face of −1 corners: 4·10^9 reads, a hang). Such
+/// numbers are refused first: a vertex takes 6 bytes or more ("0 0 0\n"; 12 in binary), a face 2
+/// or more, and a face has at most as many corners as there are vertices. The faces are checked in
+/// plain ASCII OFF (the header "OFF": 3 coordinates a vertex), read as OpenMesh reads them, number
+/// after number.
 void check_off_counts(const std::string& bytes, const std::filesystem::path& file) {
   const auto line_end = bytes.find('\n');
   if (line_end == std::string::npos) return;  // no counts: OpenMesh refuses the file itself
   const std::string header = bytes.substr(0, line_end);
   if (header.find("OFF") == std::string::npos) return;
+  const bool binary = header.find("BINARY") != std::string::npos;
   long long vertices = 0, faces = 0;
-  if (header.find("BINARY") != std::string::npos) {
+  std::istringstream in;
+  if (binary) {
     // 32-bit counts after the header line, in an order OpenMesh chooses: the smaller reading of each.
     if (bytes.size() < line_end + 1 + 8) return;
     auto count = [&](std::size_t at) {
@@ -75,7 +82,7 @@ void check_off_counts(const std::string& bytes, const std::filesystem::path& fil
     faces = count(line_end + 5);
   } else {
     // The counts follow the magic word, on its line or the next.
-    std::istringstream in(bytes.substr(0, line_end + 256));
+    in.str(bytes);
     std::string magic;
     in >> magic;
     if (header.find("nOFF") != std::string::npos) {
@@ -88,6 +95,23 @@ void check_off_counts(const std::string& bytes, const std::filesystem::path& fil
   if (vertices < 0 || faces < 0 || vertices > size / 6 || faces > size / 2)
     throw file_error(file, fmt::format("OFF header announces {} vertices and {} faces: more than {} bytes can hold",
                                        vertices, faces, size));
+  std::string magic_word;
+  std::istringstream(header) >> magic_word;
+  if (binary || magic_word != "OFF") return;
+  std::string word;
+  auto skip = [&](long long numbers) {
+    while (numbers-- > 0 && in >> word) continue;
+  };
+  skip(3 * vertices);
+  for (long long face = 1; face <= faces && in >> word; ++face) {
+    long long corners = 0;
+    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), corners);
+    if (error != std::errc() || end != word.data() + word.size()) return;  // OpenMesh's error
+    if (corners < 0 || corners > vertices)
+      throw file_error(file, fmt::format("OFF face {} has {} corners, expected 3 to {} (the number of vertices)",
+                                         face, corners, vertices));
+    skip(corners);
+  }
 }
 
 }  // namespace
