@@ -29,6 +29,8 @@ constexpr char kMagicV3[8] = {'B', 'F', 'C', 'K', 'P', 'T', '0', '3'};
 // Bytes per element of the format-2/3 arrays: a vertex is 3 doubles + ref + 2 flags + φ + its
 // halfedge; an edge 2 × (vertex, next, face) + ref + 3 flags; a face its halfedge + region.
 constexpr std::uint64_t kVertexBytes = 42, kEdgeBytes = 31, kFaceBytes = 8;
+// Format 1: a vertex is 3 doubles + ref + 2 flags + φ; a face its 3 corners + region.
+constexpr std::uint64_t kV1VertexBytes = 38, kV1FaceBytes = 16;
 
 /// Checkpoint bytes written through a cursor into a buffer sized beforehand: the snapshot is one
 /// sequential pass of fixed-size copies, with no growth or bounds check per value.
@@ -321,9 +323,11 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
   const auto nv = in.get<std::uint64_t>();
   const auto ne = c.format >= 2 ? in.get<std::uint64_t>() : 0;
   const auto nf = in.get<std::uint64_t>();
-  // Counts against the length before anything is allocated.
-  if (nv > (1ull << 31) || ne > (1ull << 30) || nf > (1ull << 31) ||
-      (c.format >= 2 && kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf > in.remaining()))
+  // Counts against the length before anything is allocated (format 1 too: a 41-byte file once
+  // reserved 2^31 vertices, found by fuzz_checkpoint).
+  const std::uint64_t needed = c.format >= 2 ? kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf
+                                             : kV1VertexBytes * nv + kV1FaceBytes * nf;
+  if (nv > (1ull << 31) || ne > (1ull << 30) || nf > (1ull << 31) || needed > in.remaining())
     throw InputError(fmt::format("{}: corrupt checkpoint sizes ({} vertices, {} edges, {} faces in {} bytes)", name,
                                  nv, ne, nf, data.size()));
   c.mesh = c.format >= 2 ? read_v2(in, nv, ne, nf) : read_v1(in, nv, nf);
