@@ -89,7 +89,8 @@ void check_off_counts(const std::string& bytes, const std::filesystem::path& fil
       long long dimension = 0;
       in >> dimension;
     }
-    if (!(in >> vertices >> faces)) return;  // OpenMesh reports malformed counts
+    long long edges = 0;  // (unused by OpenMesh)
+    if (!(in >> vertices >> faces >> edges)) return;  // OpenMesh reports malformed counts
   }
   const auto size = static_cast<long long>(bytes.size());
   if (vertices < 0 || faces < 0 || vertices > size / 6 || faces > size / 2)
