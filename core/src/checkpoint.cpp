@@ -135,6 +135,8 @@ SurfaceMesh read_v1(Cursor& in, std::uint64_t nv, std::uint64_t nf) {
   for (std::uint64_t i = 0; i < nv; ++i) get_vertex(in, mesh, vertices[i] = mesh.new_vertex(Vec3(0, 0, 0)));
   for (std::uint64_t i = 0; i < nf; ++i) {
     const int a = in.index(nv, "vertex"), b = in.index(nv, "vertex"), c = in.index(nv, "vertex");
+    // OpenMesh asserts (abort) on a face that uses a vertex twice (found by fuzz_checkpoint).
+    if (a == b || b == c || a == c) in.corrupt(fmt::format("face {} uses a vertex twice", i));
     const auto f = mesh.add_face(vertices[a], vertices[b], vertices[c]);
     if (!f.is_valid()) throw InputError(fmt::format("{}: face {} is not manifold", in.name(), i));
     mesh.region(f) = in.get<std::int32_t>();
