@@ -59,8 +59,7 @@ class CaptureOpenMeshErrors {
 /// number says, past the end of the file too (a face of −1 corners: 4·10^9 reads, a hang). Such
 /// numbers are refused first: a vertex takes 6 bytes or more ("0 0 0\n"; 12 in binary), a face 2
 /// or more, and a face has at most as many corners as there are vertices. The faces are checked in
-/// plain ASCII OFF (the header "OFF": 3 coordinates a vertex), read as OpenMesh reads them, number
-/// after number.
+/// plain ASCII OFF (the header "OFF": 3 coordinates a vertex).
 void check_off_counts(const std::string& bytes, const std::filesystem::path& file) {
   const auto line_end = bytes.find('\n');
   if (line_end == std::string::npos) return;  // no counts: OpenMesh refuses the file itself
@@ -99,19 +98,43 @@ void check_off_counts(const std::string& bytes, const std::filesystem::path& fil
   std::string magic_word;
   std::istringstream(header) >> magic_word;
   if (binary || magic_word != "OFF") return;
+  auto check_corners = [&](long long face, const std::string& word) {
+    long long corners = 0;
+    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), corners);
+    if (error != std::errc() || end != word.data() + word.size()) return false;  // OpenMesh's error
+    if (corners < 0 || corners > vertices)
+      throw file_error(file, fmt::format("OFF face {} has {} corners, expected 3 to {} (the number of vertices)",
+                                         face, corners, vertices));
+    return true;
+  };
+  // A malformed file may be read a vertex a line or a number at a time: both readings are checked
+  // (they agree on a well-formed file).
+  const auto after_counts = in.tellg();
+  std::string line;
+  std::getline(in, line);  // the rest of the counts' line
+  auto first_word = [&]() {
+    while (std::getline(in, line)) {
+      std::string word;
+      std::istringstream(line) >> word;
+      if (!word.empty() && word[0] != '#') return word;
+    }
+    return std::string();
+  };
+  for (long long v = 0; v < vertices && !first_word().empty(); ++v) continue;
+  for (long long face = 1; face <= faces; ++face) {
+    const std::string word = first_word();
+    if (word.empty() || !check_corners(face, word)) break;
+  }
+  in.clear();
+  in.seekg(after_counts);
   std::string word;
   auto skip = [&](long long numbers) {
     while (numbers-- > 0 && in >> word) continue;
   };
   skip(3 * vertices);
   for (long long face = 1; face <= faces && in >> word; ++face) {
-    long long corners = 0;
-    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), corners);
-    if (error != std::errc() || end != word.data() + word.size()) return;  // OpenMesh's error
-    if (corners < 0 || corners > vertices)
-      throw file_error(file, fmt::format("OFF face {} has {} corners, expected 3 to {} (the number of vertices)",
-                                         face, corners, vertices));
-    skip(corners);
+    if (!check_corners(face, word)) return;
+    skip(std::stoll(word));
   }
 }
 
