@@ -11,6 +11,7 @@ PACKAGES=(
   libpng-dev libgdal-dev
   gdal-bin  # gdal_translate: the GeoTIFF test converts an .asc to .tif with it
   python3-vtk9 python3-meshio  # tests/test_io.cpp cross-checks VTU and Medit files (skipped when absent)
+  clang libclang-rt-14-dev llvm  # the sanitize and fuzz stages of run_tests.sh: ASan/UBSan, libFuzzer, llvm-symbolizer
 )
 
 missing=()

@@ -361,8 +361,10 @@ TEST_CASE("truncated or corrupt .meshb/.solb: an InputError naming the file, nev
     int version;
     std::int64_t count;
   };
-  for (const auto& [version, count] :
+  for (const Corruption& corruption :
        {Corruption{2, 0x7fffffff}, Corruption{2, -5}, Corruption{4, std::int64_t(1) << 62}, Corruption{4, -1}}) {
+    const int version = corruption.version;  // variables, not bindings: CAPTURE's lambda takes them (clang 14)
+    const std::int64_t count = corruption.count;
     CAPTURE(version);
     CAPTURE(count);
     std::string bytes = square_meshb(version, false);

@@ -96,10 +96,15 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
   const std::string shape = p.choice("shape", "", {"refs", "sol", "cap", "disks", "balls"});
   if (shape == "refs") {
     out.kind = RegionSpec::Kind::Refs;
-    const auto refs = p.numbers("refs", {});
+    // Integers that fit an int (converting 1e300 to int was undefined: found by fuzz_case).
+    const auto refs = p.numbers("refs", {}, std::nullopt,
+                                {.min = std::numeric_limits<int>::min(), .max = std::numeric_limits<int>::max()});
     if (p.has("refs")) {
       out.refs.clear();
-      for (double r : refs) out.refs.push_back(int(r));
+      for (double r : refs) {
+        if (r != std::trunc(r)) p.fail("refs", fmt::format("{} is not an integer", r));
+        out.refs.push_back(int(r));
+      }
     }
     p.forbid({"sol", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'refs'");
   } else if (shape == "sol") {

@@ -32,6 +32,8 @@ constexpr std::uint64_t kMaxCaseBytes = 1 << 24;
 // Bytes per element of the format-2/3 arrays: a vertex is 3 doubles + ref + 2 flags + φ + its
 // halfedge; an edge 2 × (vertex, next, face) + ref + 3 flags; a face its halfedge + region.
 constexpr std::uint64_t kVertexBytes = 42, kEdgeBytes = 31, kFaceBytes = 8;
+// Format 1: a vertex is 3 doubles + ref + 2 flags + φ; a face its 3 corners + region.
+constexpr std::uint64_t kV1VertexBytes = 38, kV1FaceBytes = 16;
 
 /// Checkpoint bytes written through a cursor into a buffer sized beforehand: the snapshot is one
 /// sequential pass of fixed-size copies, with no growth or bounds check per value.
@@ -136,6 +138,8 @@ SurfaceMesh read_v1(Cursor& in, std::uint64_t nv, std::uint64_t nf) {
   for (std::uint64_t i = 0; i < nv; ++i) get_vertex(in, mesh, vertices[i] = mesh.new_vertex(Vec3(0, 0, 0)));
   for (std::uint64_t i = 0; i < nf; ++i) {
     const int a = in.index(nv, "vertex"), b = in.index(nv, "vertex"), c = in.index(nv, "vertex");
+    // OpenMesh asserts (abort) on a face that uses a vertex twice (found by fuzz_checkpoint).
+    if (a == b || b == c || a == c) in.corrupt(fmt::format("face {} uses a vertex twice", i));
     const auto f = mesh.add_face(vertices[a], vertices[b], vertices[c]);
     if (!f.is_valid()) throw InputError(fmt::format("{}: face {} is not manifold", in.name(), i));
     mesh.region(f) = in.get<std::int32_t>();
@@ -325,9 +329,11 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
   const auto nv = in.get<std::uint64_t>();
   const auto ne = c.format >= 2 ? in.get<std::uint64_t>() : 0;
   const auto nf = in.get<std::uint64_t>();
-  // Counts against the length before anything is allocated.
-  if (nv > (1ull << 31) || ne > (1ull << 30) || nf > (1ull << 31) ||
-      (c.format >= 2 && kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf > in.remaining()))
+  // Counts against the length before anything is allocated (format 1 too: a 41-byte file once
+  // reserved 2^31 vertices, found by fuzz_checkpoint).
+  const std::uint64_t needed = c.format >= 2 ? kVertexBytes * nv + kEdgeBytes * ne + kFaceBytes * nf
+                                             : kV1VertexBytes * nv + kV1FaceBytes * nf;
+  if (nv > (1ull << 31) || ne > (1ull << 30) || nf > (1ull << 31) || needed > in.remaining())
     throw InputError(fmt::format("{}: corrupt checkpoint sizes ({} vertices, {} edges, {} faces in {} bytes)", name,
                                  nv, ne, nf, data.size()));
   c.mesh = c.format >= 2 ? read_v2(in, nv, ne, nf) : read_v1(in, nv, nf);

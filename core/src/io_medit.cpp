@@ -18,6 +18,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string_view>
 
@@ -349,6 +350,12 @@ void check_dimension(int dimension, const std::function<InputError(const std::st
   if (dimension != 2 && dimension != 3) throw error(fmt::format("unsupported Dimension {} (expected 2 or 3)", dimension));
 }
 
+/// A file's 1-based index, 0-based. The smallest int64 stays as it is (an index out of range for the
+/// builder to report) instead of overflowing.
+std::int64_t zero_based(std::int64_t index) {
+  return index == std::numeric_limits<std::int64_t>::min() ? index : index - 1;
+}
+
 /// Room for `count` records of at least `min_bytes` each, to reject absurd counts before allocating.
 bool plausible_count(std::int64_t count, std::size_t remaining, std::size_t min_bytes) {
   return count >= 0 && std::uint64_t(count) <= remaining / min_bytes + 1;
@@ -378,7 +385,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
       in.set_context(section, i, n);
       in.skip_blank();
       at.push_line(in.line());
-      items.push_back(in.integer("an index") - 1);
+      items.push_back(zero_based(in.integer("an index")));
     }
     in.set_context(nullptr, 0, 0);
   };
@@ -425,7 +432,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
         in.skip_blank();
         r.triangle_at.push_line(in.line());
         std::array<std::int64_t, 3> t{};
-        for (auto& v : t) v = in.integer("a vertex index") - 1;
+        for (auto& v : t) v = zero_based(in.integer("a vertex index"));
         r.triangles.push_back(t);
         r.triangle_refs.push_back(int(in.integer("the triangle ref")));
       }
@@ -438,7 +445,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
         in.skip_blank();
         r.edge_at.push_line(in.line());
         std::array<std::int64_t, 2> e{};
-        for (auto& v : e) v = in.integer("a vertex index") - 1;
+        for (auto& v : e) v = zero_based(in.integer("a vertex index"));
         r.edges.push_back(e);
         r.edge_refs.push_back(int(in.integer("the edge ref")));
       }
@@ -493,7 +500,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   auto index_list = [&](const char* section, BulkVector<std::int64_t>& items, Locator& at) {
     auto n = records(section, format.int_size());
     at = Locator::bytes(in.pos(), format.int_size());
-    for (std::int64_t i = 0; i < n; ++i) items.push_back(read_index() - 1);
+    for (std::int64_t i = 0; i < n; ++i) items.push_back(zero_based(read_index()));
   };
   walk_binary_keywords(in, format, [&](int code, std::size_t start) {
     switch (code) {
@@ -523,7 +530,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         r.triangle_refs.resize(std::size_t(n));
         for (std::int64_t i = 0; i < n; ++i) {
           auto& t = r.triangles[std::size_t(i)];
-          for (auto& v : t) v = read_index() - 1;
+          for (auto& v : t) v = zero_based(read_index());
           r.triangle_refs[std::size_t(i)] = int(read_index());
         }
         break;
@@ -536,7 +543,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         r.edge_refs.resize(std::size_t(n));
         for (std::int64_t i = 0; i < n; ++i) {
           auto& e = r.edges[std::size_t(i)];
-          for (auto& v : e) v = read_index() - 1;
+          for (auto& v : e) v = zero_based(read_index());
           r.edge_refs[std::size_t(i)] = int(read_index());
         }
         break;

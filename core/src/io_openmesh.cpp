@@ -10,6 +10,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cstdint>
@@ -22,17 +23,18 @@ namespace bodyfit::io_detail {
 namespace {
 
 /// Collect what OpenMesh prints on omerr while in scope (instead of letting it reach stderr).
+/// omerr writes to std::cerr: its buffer is swapped for ours. (Not omerr().connect/disconnect:
+/// OpenMesh's disconnect never deletes the target that connect allocated, a leak per call.)
 class CaptureOpenMeshErrors {
  public:
   CaptureOpenMeshErrors() : log_was_enabled_(omlog().is_enabled()) {
-    was_on_cerr_ = omerr().disconnect(std::cerr);
-    omerr().connect(captured_);
+    omerr().flush();
+    cerr_buffer_ = std::cerr.rdbuf(captured_.rdbuf());
     omlog().disable();  // OpenMesh's writers log "[OBJWriter] : write file" on every call
   }
   ~CaptureOpenMeshErrors() {
     omerr().flush();
-    omerr().disconnect(captured_);
-    if (was_on_cerr_) omerr().connect(std::cerr);
+    std::cerr.rdbuf(cerr_buffer_);
     if (log_was_enabled_) omlog().enable();
   }
   CaptureOpenMeshErrors(const CaptureOpenMeshErrors&) = delete;
@@ -49,7 +51,7 @@ class CaptureOpenMeshErrors {
 
  private:
   std::ostringstream captured_;
-  bool was_on_cerr_ = false;
+  std::streambuf* cerr_buffer_ = nullptr;
   bool log_was_enabled_ = true;
 };
 
@@ -140,11 +142,93 @@ void check_declared_counts(std::string_view bytes, const std::string& ext, const
   }
 }
 
+/// OpenMesh's OFF reader trusts the numbers of the file (found by fuzz_openmesh): besides the
+/// header's counts (check_declared_counts, run first), it reads as many indices as a face's first
+/// number says, past the end of the file too (a face of −1 corners: 4·10^9 reads, a hang). A face
+/// has at most as many corners as there are vertices: checked in plain ASCII OFF (the header "OFF":
+/// 3 coordinates a vertex).
+void check_off_faces(const std::string& bytes, const std::filesystem::path& file) {
+  const auto line_end = bytes.find('\n');
+  if (line_end == std::string::npos) return;  // no counts: OpenMesh refuses the file itself
+  const std::string header = bytes.substr(0, line_end);
+  if (header.find("OFF") == std::string::npos) return;
+  const bool binary = header.find("BINARY") != std::string::npos;
+  long long vertices = 0, faces = 0;
+  std::istringstream in;
+  if (binary) {
+    // 32-bit counts after the header line, in an order OpenMesh chooses: the smaller reading of each.
+    if (bytes.size() < line_end + 1 + 8) return;
+    auto count = [&](std::size_t at) {
+      std::uint32_t le = 0;
+      std::memcpy(&le, bytes.data() + at, 4);
+      const std::uint32_t be = (le >> 24) | ((le >> 8) & 0xff00u) | ((le << 8) & 0xff0000u) | (le << 24);
+      return static_cast<long long>(std::min(le, be));
+    };
+    vertices = count(line_end + 1);
+    faces = count(line_end + 5);
+  } else {
+    // The counts follow the magic word, on its line or the next.
+    in.str(bytes);
+    std::string magic;
+    in >> magic;
+    if (header.find("nOFF") != std::string::npos) {
+      long long dimension = 0;
+      in >> dimension;
+    }
+    long long edges = 0;  // (unused by OpenMesh)
+    if (!(in >> vertices >> faces >> edges)) return;  // OpenMesh reports malformed counts
+  }
+  std::string magic_word;
+  std::istringstream(header) >> magic_word;
+  if (binary || magic_word != "OFF") return;
+  auto check_corners = [&](long long face, const std::string& word) {
+    long long corners = 0;
+    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), corners);
+    if (error != std::errc() || end != word.data() + word.size()) return false;  // OpenMesh's error
+    if (corners < 0 || corners > vertices)
+      throw file_error(file, fmt::format("OFF face {} has {} corners, expected 3 to {} (the number of vertices)",
+                                         face, corners, vertices));
+    return true;
+  };
+  // A malformed file may be read a vertex a line or a number at a time: both readings are checked
+  // (they agree on a well-formed file).
+  const auto after_counts = in.tellg();
+  std::string line;
+  std::getline(in, line);  // the rest of the counts' line
+  auto first_word = [&]() {
+    while (std::getline(in, line)) {
+      std::string word;
+      std::istringstream(line) >> word;
+      if (!word.empty() && word[0] != '#') return word;
+    }
+    return std::string();
+  };
+  for (long long v = 0; v < vertices && !first_word().empty(); ++v) continue;
+  for (long long face = 1; face <= faces; ++face) {
+    const std::string word = first_word();
+    if (word.empty() || !check_corners(face, word)) break;
+  }
+  in.clear();
+  in.seekg(after_counts);
+  std::string word;
+  auto skip = [&](long long numbers) {
+    while (numbers-- > 0 && in >> word) continue;
+  };
+  skip(3 * vertices);
+  for (long long face = 1; face <= faces && in >> word; ++face) {
+    if (!check_corners(face, word)) return;
+    skip(std::stoll(word));
+  }
+}
+
 }  // namespace
 
 SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options) {
-  // A clear error for a missing or unreadable file, and for counts the file cannot hold.
-  check_declared_counts(read_file_bytes(file), extension_of(file), file);
+  // A clear error for a missing or unreadable file, for counts the file cannot hold and for OFF
+  // faces OpenMesh would read past the end of the file.
+  const std::string bytes = read_file_bytes(file);
+  check_declared_counts(bytes, extension_of(file), file);
+  if (extension_of(file) == ".off") check_off_faces(bytes, file);
   SurfaceMesh raw;
   OpenMesh::IO::Options io_options;
   std::string complaint;

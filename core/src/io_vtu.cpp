@@ -97,7 +97,9 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
     point_blocks.push_back(std::move(b));
   };
   point_scalar("phi", [&](VertexHandle v) { return mesh.phi(v); });
-  for (const auto& [name, values] : fields.point_scalars) {
+  for (const auto& field : fields.point_scalars) {
+    const std::string& name = field.first;
+    const ScalarField& values = field.second;  // a variable, not a binding: lambdas capture it (clang 14)
     if (compact) {
       Block b{fmt::format(R"(type="Float64" Name="{}")", xml_escape(name)), {}};
       append_raw(b.bytes, values.data(), values.size());
