@@ -36,7 +36,7 @@ void check_face_budget(double estimated_faces, std::string_view what);
 double faces_for_edge_length(double area, double h);
 
 /// A lower bound of the faces remesh() will produce: no edge longer than hmax (its default when
-/// 0: the bounding-box diagonal / 20) over the surface's area. Non-finite for hmax ≤ 0 or NaN.
+/// 0: the input's resolution, resolution_length) over the surface's area. Non-finite for hmax < 0 or NaN.
 double estimate_remesh_faces(const SurfaceMesh& mesh, const RemeshOptions& options);
 
 /// The index of the first NaN or infinite value (of a component, for vectors); npos when none.
