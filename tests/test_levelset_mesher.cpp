@@ -561,8 +561,9 @@ TEST_CASE("bad level sets are input errors; deleted elements are collected") {
 }
 
 TEST_CASE("the quad of a two-crossing cut gets the diagonal whose worse triangle is better") {
-  for (auto [phi_b, phi_c] : {std::pair{1.0, 3.0}, std::pair{3.0, 1.0}, std::pair{1.0, 9.0}, std::pair{9.0, 1.0},
-                              std::pair{0.5, 2.0}, std::pair{2.0, 0.5}}) {
+  for (auto values : {std::pair{1.0, 3.0}, std::pair{3.0, 1.0}, std::pair{1.0, 9.0}, std::pair{9.0, 1.0},
+                      std::pair{0.5, 2.0}, std::pair{2.0, 0.5}}) {
+    const double phi_b = values.first, phi_c = values.second;  // not a structured binding: CAPTURE (clang 14)
     CAPTURE(phi_b);
     CAPTURE(phi_c);
     SurfaceMesh mesh;
