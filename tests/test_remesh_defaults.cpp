@@ -77,7 +77,9 @@ TEST_CASE("remesh at its defaults keeps the input's resolution, quality and topo
   Input inputs[] = {{"bumpy sphere", bumpy_sphere()},
                     {"thin blade", thin_blade()},
                     {"bracket", read_mesh(test::source_path("meshes/parts/bracket_h0.05.mesh"))}};
-  for (auto& [name, mesh] : inputs) {
+  for (auto& input : inputs) {
+    const char* name = input.name;  // not a structured binding: CAPTURE (clang 14)
+    SurfaceMesh& mesh = input.mesh;
     CAPTURE(name);
     const std::size_t faces = mesh.n_faces();
     const long euler = euler_characteristic(mesh);
