@@ -130,8 +130,10 @@ TEST_CASE("H1 smoothing: l = 0 is the identity, constants are kept, harmonics ar
     Eigen::Map<const Eigen::VectorXd> gv(g.data(), Eigen::Index(g.size()));
     return gv.dot(m * gv);
   };
-  for (auto [degree, function] : {std::pair<int, double (*)(const Vec3&)>{1, [](const Vec3& p) { return p[2]; }},
-                                  std::pair<int, double (*)(const Vec3&)>{8, harmonic8}}) {
+  for (auto harmonic : {std::pair<int, double (*)(const Vec3&)>{1, [](const Vec3& p) { return p[2]; }},
+                         std::pair<int, double (*)(const Vec3&)>{8, harmonic8}}) {
+    const int degree = harmonic.first;  // not a structured binding: CAPTURE (clang 14)
+    const auto function = harmonic.second;
     ScalarField g = field(sphere, function);
     ScalarField u = smoother.smooth(g);
     double expected = 1.0 / (1.0 + 0.04 * degree * (degree + 1));
