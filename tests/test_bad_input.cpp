@@ -230,6 +230,9 @@ TEST_CASE("damaged, truncated or inconsistent files are input errors (exit 1) na
       {"discretize " + kSphere + " --phi {d}/phi_nan.sol -o {d}/out.mesh", 1, "every value must be finite", "out.mesh"},
       {"remesh {d}/missing.mesh -o {d}/out.mesh", 1, "missing.mesh: cannot open", "out.mesh"},
       {"discretize " + kSphere + " --phi {d}/missing.sol -o {d}/out.mesh", 1, "missing.sol: cannot open", "out.mesh"},
+      {"run {d}/missing.toml -o {d}/out", 1, "missing.toml: cannot open", "out"},
+      {"render {d}/missing.mesh -o {d}/out.png", 1, "missing.mesh", "out.png"},
+      {"plot {d}/missing.csv --column ms_total -o {d}/out.png", 1, "missing.csv", "out.png"},
   });
 }
 
@@ -245,6 +248,11 @@ TEST_CASE("sizes and work are estimated before starting and refused above the li
       {kAdvect + "--velocity {d}/v.sol --time 1e12", 1, "sub-steps", "out.sol"},
       {kAdvect + "--velocity {d}/v.sol --time 1 --cells 1e-9", 1, "sub-steps", "out.sol"},
       {kAdvect + "--velocity {d}/v.sol --time 1 --max-substeps 10", 1, "above the limit of 10", "out.sol"},
+      // Without the estimate's limit, a speed that overflows loses every characteristic: a wrong
+      // answer, so a numerical error (exit 5) and nothing written.
+      {kAdvect + "--velocity {d}/v_huge.sol --time 1 --max-substeps 0", 5, "characteristics were lost", "out.sol"},
+      // An hmin alone above the input's resolution coarsens (said, not silently clamped away).
+      {"remesh " + kSphere + " --hmin 0.5 -o {d}/out.mesh", 0, "hmax raised to 0.5", "out.mesh", true},
   });
 }
 
@@ -259,6 +267,8 @@ TEST_CASE("case values: non-finite, out of range or too big are input errors (ex
       {run + "surface.h=1e-5", 1, "[surface] h = 1e-05 on a sphere of radius 1: about", "out/final.mesh"},
       {run + "remesh.hmax=1e-5", 1, "[remesh] hmax = 1e-05: about", "out/final.mesh"},
       {run + "time.dt=1e6", 1, "sub-steps", "out/final.mesh"},
+      {run + "time.dt=1e6 --set time.max_cfl=1 --overwrite", 1, "CFL sub-steps", "out/final.mesh"},
+      {run + "time.dt=10 --set time.max_cfl=1 --set time.max_substeps=20 --overwrite", 1, "above the limit of 20", "out/final.mesh"},
   });
 }
 

@@ -4,9 +4,11 @@
 #include "validators.hpp"
 
 #include <bodyfit/advection.hpp>
+#include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -60,6 +62,12 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
             args->options.gradient_correction = !args->plain_p1;
             const auto result = bodyfit::advect(mesh, phi, velocity, args->time, args->options, &report);
             const double advect_ms = ms_since(advect_start);
+            // A lost characteristic leaves a value from the middle of its path: a wrong answer.
+            if (report.lost > 0)
+              throw bodyfit::NumericalError(fmt::format(
+                  "advect: {} of {} characteristics were lost (a walk stalled or overflowed, or a trace reached its "
+                  "bound of sub-steps); {} not written: shorten --time or check the velocity",
+                  report.lost, report.traced, args->output));
             bodyfit::require_finite(result, "advect: the advected level set");
             bodyfit::write_scalar_sol(args->output, result);
             spdlog::info(
@@ -67,7 +75,6 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
                 "boundary, {} lost; advect {:.1f} ms, read {:.1f} ms, total {:.1f} ms -> {}",
                 mesh.n_vertices(), mesh.n_faces(), args->time, args->options.rk_order, report.traced, report.substeps,
                 report.hit_boundary, report.lost, advect_ms, read_ms, ms_since(start), args->output);
-            if (report.lost > 0) spdlog::warn("advect: {} characteristics were lost", report.lost);
             return 0;
           }};
 }

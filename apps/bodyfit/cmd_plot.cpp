@@ -109,7 +109,8 @@ int plot_command(const PlotArguments& args) {
 bodyfit::cli::Command setup_plot(CLI::App& app) {
   auto* cmd = app.add_subcommand("plot", "plot columns of history.csv files (or any CSV with a header) to a PNG");
   auto args = std::make_shared<PlotArguments>();
-  cmd->add_option("csv", args->files, "CSV files (e.g. out/history.csv; several compare runs)")->required()->check(CLI::ExistingFile);
+  // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
+  cmd->add_option("csv", args->files, "CSV files (e.g. out/history.csv; several compare runs)")->required();
   cmd->add_option("-y,--column", args->columns, "column(s) to plot (repeatable)")->required();
   cmd->add_option("-x", args->x, "column of the horizontal axis")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "output .png")->required();

@@ -65,7 +65,8 @@ int render_command(const RenderArguments& args) {
 bodyfit::cli::Command setup_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "render a mesh to a PNG image (region colours or a field with a colorbar)");
   auto args = std::make_shared<RenderArguments>();
-  cmd->add_option("mesh", args->input, "input mesh")->required()->check(CLI::ExistingFile);
+  // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
+  cmd->add_option("mesh", args->input, "input mesh")->required();
   cmd->add_option("-o,--output", args->output, "output .png")->required();
   cmd->add_option("--field", args->field, "region | phi | d | quality | height | a .sol file")->capture_default_str();
   cmd->add_option("--view", args->view, "iso | top | front")->capture_default_str();

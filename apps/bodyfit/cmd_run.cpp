@@ -395,7 +395,8 @@ int run_case(const RunArguments& args) {
 bodyfit::cli::Command setup_run(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "run a case: evolve the region G(t) with a velocity model (docs/running.md)");
   auto args = std::make_shared<RunArguments>();
-  cmd->add_option("case", args->case_file, "case file (.toml)")->required()->check(CLI::ExistingFile);
+  // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
+  cmd->add_option("case", args->case_file, "case file (.toml)")->required();
   cmd->add_option("-o,--output", args->output_dir, "output directory (default: <case name>.out)");
   cmd->add_option("--set", args->sets, "override a key of the case, e.g. --set time.dt=0.05 (repeatable)");
   auto* resume =

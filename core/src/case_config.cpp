@@ -8,7 +8,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -181,6 +184,7 @@ void parse_time(const toml::table& table, TimeSpec& out) {
   out.cfl = p.number("cfl", 0, kPositive);
   out.max_cfl = p.number("max_cfl", 0, kPositive);
   out.narrow_band = p.boolean("narrow_band", out.narrow_band);
+  out.max_substeps = long(p.integer("max_substeps", out.max_substeps, 0));
   out.final_time = p.number("final_time", out.final_time, kPositive);
   out.iterations = long(p.integer("iterations", -1, 0));
   out.max_rejections = clamp_to_int(p.integer("max_rejections", out.max_rejections, 0));
@@ -305,6 +309,8 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
 
 CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   toml::table table;
+  if (std::ifstream probe(file); !probe)  // toml++ would say "line 0: File could not be opened"
+    throw file_error(file, fmt::format("cannot open for reading ({})", std::strerror(errno)));
   try {
     table = toml::parse_file(file.string());
   } catch (const toml::parse_error& e) {

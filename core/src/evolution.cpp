@@ -185,7 +185,7 @@ class Evolution {
     ScalarField phi = distance_;
     while (step.done < dt) {
       const double remaining = dt - step.done;
-      const double sub = substep_length(velocity, {}, remaining);
+      const double sub = substep_length(velocity, {}, remaining, step.substeps);
       ScalarField next = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
       step.ms.advect += clock.lap_ms();
       phi = std::move(next);
@@ -247,7 +247,7 @@ class Evolution {
       traced.clear();
       for (int v : band)
         if (std::abs(phi[v]) <= traced_width) traced.push_back(v);
-      const double sub = substep_length(velocity, traced, remaining);
+      const double sub = substep_length(velocity, traced, remaining, step.substeps);
       if (in_band) {
         AdvectionReport report;
         advector.advect_band(phi, velocity, sub, traced, band, next, options_.advection, &report);
@@ -297,13 +297,19 @@ class Evolution {
     step.done = sub == remaining ? dt : step.done + sub;
   }
 
+  /// A lost characteristic leaves its vertex with a value from the middle of its path: a wrong φ,
+  /// so the step is not taken (everything up to T^n is in the last checkpoint).
   void check_report(const AdvectionReport& report) const {
-    if (report.lost > 0) spdlog::warn("iteration {}: {} characteristics lost in advection", n_, report.lost);
+    if (report.lost > 0)
+      throw NumericalError(fmt::format(
+          "step {} (t = {:.6g}): {} of {} characteristics were lost in the advection (a walk stalled or overflowed, "
+          "or a trace reached its bound of sub-steps); the step is not taken: shorten [time] dt or set max_cfl",
+          n_ + 1, t_, report.lost, report.traced));
   }
 
   /// Equal sub-steps over what remains of the step, each moving no point of `band` (all when
   /// empty) by more than max_cfl·h.
-  double substep_length(const VectorField& velocity, std::span<const int> band, double remaining) const {
+  double substep_length(const VectorField& velocity, std::span<const int> band, double remaining, int taken) const {
     if (!(options_.max_cfl > 0)) return remaining;
     double vmax = 0;
     if (band.empty())
@@ -315,6 +321,13 @@ class Evolution {
                                     "size the sub-steps)",
                                     model_.name(), n_));
     const double ratio = vmax * remaining / (options_.max_cfl * cfl_length());
+    const double needed = taken + std::ceil(ratio - 1e-9);
+    if (options_.max_substeps > 0 && needed > double(options_.max_substeps))
+      throw InputError(fmt::format(
+          "step {} (t = {:.6g}, dt = {:.6g}) needs {:.3g} CFL sub-steps (max |V| {:.3g} over {:.6g} of time, max_cfl "
+          "{:.3g} × h {:.3g}), above the limit of {}: shorten [time] dt (or cfl), or raise [time] max_substeps (0: no "
+          "limit)",
+          n_ + 1, t_, options_.dt, needed, vmax, remaining, options_.max_cfl, cfl_length(), options_.max_substeps));
     return ratio > 1 + 1e-9 ? remaining / std::ceil(ratio - 1e-9) : remaining;  // 3.0000000000000004 is 3
   }
 

@@ -1,6 +1,10 @@
 // Remesher: feature classification (ridges, curves, corners, kinds of vertices) and the sizing field.
 #include "remesher.hpp"
 
+#include <bodyfit/error.hpp>
+
+#include <fmt/format.h>
+
 namespace bodyfit::remesh_detail {
 
 void Remesher::setup_sizes() {
@@ -9,7 +13,13 @@ void Remesher::setup_sizes() {
   hmax_ = opt_.hmax > 0 ? opt_.hmax : resolution_length(m_);
   if (hmax_ <= 0) hmax_ = diag / 20;
   hmin_ = opt_.hmin > 0 ? opt_.hmin : hmax_ / 20;
-  hmin_ = std::min(hmin_, hmax_);
+  if (hmin_ > hmax_) {  // only an hmin given: it asks for coarser than the input's resolution
+    if (opt_.hmax > 0)
+      throw InputError(fmt::format("remesh: hmin {:.6g} exceeds hmax {:.6g}", opt_.hmin, opt_.hmax));
+    spdlog::warn("remesh: hmin {:.6g} is above the default hmax {:.6g} (the input's resolution): hmax raised to {:.6g}",
+                 hmin_, hmax_, hmin_);
+    hmax_ = hmin_;
+  }
   hausd_ = opt_.hausd > 0 ? opt_.hausd : diag / 1000;
   corner_angle_ = (opt_.feature_angle > 0 ? opt_.feature_angle : 45.0) * M_PI / 180.0;
 }

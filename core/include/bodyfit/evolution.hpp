@@ -90,6 +90,9 @@ struct EvolutionOptions {
   /// false: every stage on the whole surface (the reference the band is tested against).
   bool narrow_band = true;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
+  /// CFL sub-steps one step may take (0: no limit): a Δt far beyond what the speeds allow is an
+  /// InputError at the step that needs more, naming the count, not a run that never ends.
+  long max_substeps = 10000;
   double final_time = std::numeric_limits<double>::infinity();
   long max_iterations = -1;      ///< stop when the iteration counter reaches this (−1: no limit)
   int max_rejections = 5;        ///< retries (each with half the Δt) of a step the model rejects
