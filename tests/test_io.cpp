@@ -8,6 +8,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -792,6 +793,122 @@ TEST_CASE("bad input through OpenMesh formats: non-manifold input is refused, no
   CHECK(contains(m, "zero area"));
   m = read_error(dir, "nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   CHECK(contains(m, "nan.obj"));
+}
+
+namespace {
+
+/// The unit cube as six quads (OFF corners are 0-based), outward normals.
+const char* kCubeVertices = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n";
+const int kCubeQuads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+
+/// Σ p0·(p1 × p2)/6: the volume a closed mesh encloses, positive when its normals point outward.
+double enclosed_volume(const SurfaceMesh& mesh) {
+  double six_volumes = 0;
+  for (auto f : mesh.faces()) {
+    std::vector<Vec3> p;
+    for (auto v : mesh.fv_range(f)) p.push_back(mesh.point(v));
+    six_volumes += p[0].dot(p[1].cross(p[2]));
+  }
+  return six_volumes / 6;
+}
+
+std::string cube_faces_text(const std::string& after_each) {
+  std::string text;
+  for (const auto& q : kCubeQuads) text += fmt::format("4 {} {} {} {}{}\n", q[0], q[1], q[2], q[3], after_each);
+  return text;
+}
+
+/// Geomview's binary OFF of the cube, big-endian (or little-endian), a colour on face 2.
+std::string binary_cube(bool little_endian) {
+  std::string bytes = "OFF BINARY\n";
+  auto word = [&](std::uint32_t w) {
+    if (!little_endian) w = __builtin_bswap32(w);  // (the test machine is little-endian)
+    bytes.append(reinterpret_cast<const char*>(&w), 4);
+  };
+  auto real = [&](float x) {
+    std::uint32_t w;
+    std::memcpy(&w, &x, 4);
+    word(w);
+  };
+  word(8), word(6), word(12);
+  std::istringstream vertices(kCubeVertices);
+  for (float x; vertices >> x;) real(x);
+  for (int f = 0; f < 6; ++f) {
+    word(4);
+    for (int c : kCubeQuads[f]) word(std::uint32_t(c));
+    word(f == 2 ? 3 : 0);
+    if (f == 2) real(1), real(0.5f), real(0);
+  }
+  return bytes;
+}
+
+}  // namespace
+
+TEST_CASE("OFF is read by bodyfit's parser: its variants give the same mesh, errors name the line") {
+  TempDir dir("io-off");
+  auto check_cube = [&](const std::string& name, const std::string& text) {
+    INFO(name);
+    write_text(dir / name, text);
+    const SurfaceMesh mesh = read_mesh(dir / name);
+    CHECK(mesh.n_vertices() == 8);
+    CHECK(mesh.n_faces() == 12);  // each quad a fan of two triangles
+    CHECK(total_area(mesh) == doctest::Approx(6).epsilon(1e-12));
+    CHECK(enclosed_volume(mesh) == doctest::Approx(1).epsilon(1e-12));  // oriented outward, as given
+  };
+  const std::string faces = cube_faces_text("");
+  check_cube("plain.off", std::string("OFF\n8 6 12\n") + kCubeVertices + faces);
+  check_cube("comments.off", std::string("# a cube\nOFF # keyword\n\n8 6 # no edge count\n") + kCubeVertices +
+                                 "# faces\n" + faces + "trailing words after the faces are ignored\n");
+  check_cube("same_line.off", std::string("OFF 8 6 0\n") + kCubeVertices + faces);
+  std::string coloured, homogeneous, with_normals;
+  std::istringstream lines(kCubeVertices);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream xyz(line);
+    double x, y, z;
+    xyz >> x >> y >> z;
+    coloured += line + " 0.2 0.4 0.6 1\n";
+    homogeneous += fmt::format("{} {} {} 2\n", 2 * x, 2 * y, 2 * z);
+    with_normals += line + " 0 0 1\n";
+  }
+  check_cube("colours.off", "COFF\n8 6 0\n" + coloured + cube_faces_text(" 255 0 0"));
+  check_cube("homogeneous.off", "4OFF\n8 6 0\n" + homogeneous + faces);
+  check_cube("normals.off", "NOFF\n8 6 0\n" + with_normals + faces);
+  check_cube("dimension.off", std::string("nOFF\n3\n8 6 0\n") + kCubeVertices + faces);
+  check_cube("big_endian.off", binary_cube(false));
+  check_cube("little_endian.off", binary_cube(true));
+
+  const std::string head = std::string("OFF\n8 6 0\n") + kCubeVertices;  // vertices on lines 3-10
+  auto with_face = [&](int index, const std::string& line) {  // the cube with face `index` replaced
+    std::string text = head;
+    std::istringstream in(faces);
+    int f = 0;
+    for (std::string face; std::getline(in, face); ++f) text += (f == index ? line : face) + "\n";
+    return text;
+  };
+  auto m = read_error(dir, "word.off", "OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n");
+  CHECK(contains(m, "word.off:4: vertex 2: 'zero' is not a number"));
+  m = read_error(dir, "short.off", with_face(1, "4 4 5 6"));
+  CHECK(contains(m, "short.off:12: face 2: expected 4 corners"));
+  m = read_error(dir, "index.off", with_face(0, "3 0 1 8"));
+  CHECK(contains(m, "index.off:11: face 1: corner '8' is not a vertex index (0 to 7)"));
+  m = read_error(dir, "corners.off", with_face(0, "-1 0 1 2"));
+  CHECK(contains(m, "corners.off:11: face 1 has -1 corners, expected 3 to 8"));
+  m = read_error(dir, "truncated.off", head + "# the last three faces are missing\n" + faces.substr(0, faces.find("4 1 2")));
+  CHECK(contains(m, "the file ends after 3 of its 6 faces"));
+  m = read_error(dir, "cut.off", "OFF\n8 6 0\n0 0 0\n1 0 0\n");
+  CHECK(contains(m, "declares 8 vertices and 6 faces"));
+  m = read_error(dir, "dim4.off", "nOFF\n4\n1 1 0\n0 0 0 0\n3 0 0 0\n");
+  CHECK(contains(m, "only 3 is supported"));
+  m = read_error(dir, "noff.off", "OF\n");
+  CHECK(contains(m, "not an OFF file"));
+  std::string cut_binary = binary_cube(false);
+  cut_binary.resize(cut_binary.size() - 10);
+  m = read_error(dir, "cut_binary.off", cut_binary);
+  CHECK(contains(m, "binary OFF"));
+  CHECK(contains(m, "the file ends within face 6"));
+  // A duplicated face is caught by the builder every reader shares, at its line.
+  m = read_error(dir, "twice.off", std::string("OFF\n8 7 0\n") + kCubeVertices + faces + "3 0 3 2\n");
+  CHECK(contains(m, "twice.off:17: triangle 13: non-manifold edge"));
 }
 
 TEST_CASE("writers: unknown extension or missing directory throws and leaves no file") {

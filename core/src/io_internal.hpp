@@ -125,6 +125,9 @@ std::vector<std::int64_t> vertex_numbering(const SurfaceMesh& mesh);
 MeshRecords parse_medit(std::string_view bytes, const std::filesystem::path& file);
 SurfaceMesh read_medit(const std::filesystem::path& file, const ReadOptions& options);
 void write_medit(const SurfaceMesh& mesh, const std::filesystem::path& file, bool binary);
+/// The records of an OFF file's bytes (text or binary), before build_mesh.
+MeshRecords parse_off(std::string_view bytes, const std::filesystem::path& file);
+SurfaceMesh read_off(const std::filesystem::path& file, const ReadOptions& options);
 SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options);
 void write_openmesh_format(const SurfaceMesh& mesh, const std::filesystem::path& file);
 

@@ -1,4 +1,5 @@
-// OBJ, OFF, PLY and STL through OpenMesh's readers and writers. The reader's result is turned back
+// OBJ, PLY and STL through OpenMesh's readers, and these and OFF through its writers (OFF is read
+// by io_off.cpp). The reader's result is turned back
 // into plain records and rebuilt by the validated builder, so these formats get the same checks
 // as Medit files. OpenMesh's importer repairs non-manifold input silently (it duplicates the
 // vertices of a face it cannot add and marks it "fixed non-manifold") and reports other problems
@@ -55,7 +56,7 @@ class CaptureOpenMeshErrors {
   bool log_was_enabled_ = true;
 };
 
-/// The next whitespace-separated word of `text` from `at` on, skipping '#' comments (OFF), "" at the end.
+/// The next whitespace-separated word of `text` from `at` on, skipping '#' comments, "" at the end.
 std::string_view next_word(std::string_view text, std::size_t& at) {
   for (;;) {
     while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) ++at;
@@ -107,25 +108,6 @@ void check_declared_counts(std::string_view bytes, const std::string& ext, const
                                        : fmt::format("binary STL: the header declares {} triangles ({} bytes), the "
                                                      "file has {} bytes (truncated or not an STL file?)",
                                                      triangles, binary_size, size));
-  } else if (ext == ".off") {
-    std::size_t at = 0;
-    const std::string_view keyword = next_word(bytes, at);
-    if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF")
-      throw file_error(file, "not an OFF file: it does not start with 'OFF'");
-    std::size_t after = at;
-    const bool binary = next_word(bytes, after) == "BINARY";
-    if (binary) {
-      if (size < after + 12) throw file_error(file, "binary OFF: truncated header");
-      std::uint32_t counts[2];
-      std::memcpy(counts, bytes.data() + after + 1, 8);  // after the newline that ends "BINARY"
-      // Either byte order (writers differ): refused only when neither fits.
-      if (needs(counts[0], counts[1], 12, 16) > double(size))
-        fits(__builtin_bswap32(counts[0]), __builtin_bswap32(counts[1]), 12, 16);
-    } else {
-      const std::uint64_t vertices = header_count(next_word(bytes, at), file, "vertex count");
-      const std::uint64_t faces = header_count(next_word(bytes, at), file, "face count");
-      fits(vertices, faces, 6, 8);  // "0 0 0\n", "3 0 1 2\n"
-    }
   } else if (ext == ".ply") {
     const std::size_t end = bytes.find("end_header");
     if (end == std::string_view::npos) throw file_error(file, "not a PLY file: no 'end_header'");
@@ -142,93 +124,12 @@ void check_declared_counts(std::string_view bytes, const std::string& ext, const
   }
 }
 
-/// OpenMesh's OFF reader trusts the numbers of the file (found by fuzz_openmesh): besides the
-/// header's counts (check_declared_counts, run first), it reads as many indices as a face's first
-/// number says, past the end of the file too (a face of −1 corners: 4·10^9 reads, a hang). A face
-/// has at most as many corners as there are vertices: checked in plain ASCII OFF (the header "OFF":
-/// 3 coordinates a vertex).
-void check_off_faces(const std::string& bytes, const std::filesystem::path& file) {
-  const auto line_end = bytes.find('\n');
-  if (line_end == std::string::npos) return;  // no counts: OpenMesh refuses the file itself
-  const std::string header = bytes.substr(0, line_end);
-  if (header.find("OFF") == std::string::npos) return;
-  const bool binary = header.find("BINARY") != std::string::npos;
-  long long vertices = 0, faces = 0;
-  std::istringstream in;
-  if (binary) {
-    // 32-bit counts after the header line, in an order OpenMesh chooses: the smaller reading of each.
-    if (bytes.size() < line_end + 1 + 8) return;
-    auto count = [&](std::size_t at) {
-      std::uint32_t le = 0;
-      std::memcpy(&le, bytes.data() + at, 4);
-      const std::uint32_t be = (le >> 24) | ((le >> 8) & 0xff00u) | ((le << 8) & 0xff0000u) | (le << 24);
-      return static_cast<long long>(std::min(le, be));
-    };
-    vertices = count(line_end + 1);
-    faces = count(line_end + 5);
-  } else {
-    // The counts follow the magic word, on its line or the next.
-    in.str(bytes);
-    std::string magic;
-    in >> magic;
-    if (header.find("nOFF") != std::string::npos) {
-      long long dimension = 0;
-      in >> dimension;
-    }
-    long long edges = 0;  // (unused by OpenMesh)
-    if (!(in >> vertices >> faces >> edges)) return;  // OpenMesh reports malformed counts
-  }
-  std::string magic_word;
-  std::istringstream(header) >> magic_word;
-  if (binary || magic_word != "OFF") return;
-  auto check_corners = [&](long long face, const std::string& word) {
-    long long corners = 0;
-    const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), corners);
-    if (error != std::errc() || end != word.data() + word.size()) return false;  // OpenMesh's error
-    if (corners < 0 || corners > vertices)
-      throw file_error(file, fmt::format("OFF face {} has {} corners, expected 3 to {} (the number of vertices)",
-                                         face, corners, vertices));
-    return true;
-  };
-  // A malformed file may be read a vertex a line or a number at a time: both readings are checked
-  // (they agree on a well-formed file).
-  const auto after_counts = in.tellg();
-  std::string line;
-  std::getline(in, line);  // the rest of the counts' line
-  auto first_word = [&]() {
-    while (std::getline(in, line)) {
-      std::string word;
-      std::istringstream(line) >> word;
-      if (!word.empty() && word[0] != '#') return word;
-    }
-    return std::string();
-  };
-  for (long long v = 0; v < vertices && !first_word().empty(); ++v) continue;
-  for (long long face = 1; face <= faces; ++face) {
-    const std::string word = first_word();
-    if (word.empty() || !check_corners(face, word)) break;
-  }
-  in.clear();
-  in.seekg(after_counts);
-  std::string word;
-  auto skip = [&](long long numbers) {
-    while (numbers-- > 0 && in >> word) continue;
-  };
-  skip(3 * vertices);
-  for (long long face = 1; face <= faces && in >> word; ++face) {
-    if (!check_corners(face, word)) return;
-    skip(std::stoll(word));
-  }
-}
-
 }  // namespace
 
 SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options) {
-  // A clear error for a missing or unreadable file, for counts the file cannot hold and for OFF
-  // faces OpenMesh would read past the end of the file.
+  // A clear error for a missing or unreadable file and for counts the file cannot hold.
   const std::string bytes = read_file_bytes(file);
   check_declared_counts(bytes, extension_of(file), file);
-  if (extension_of(file) == ".off") check_off_faces(bytes, file);
   SurfaceMesh raw;
   OpenMesh::IO::Options io_options;
   std::string complaint;

@@ -93,8 +93,8 @@ void read_input(Reader reader, std::string_view bytes) {
       return;
     case Reader::OpenMesh: {
       if (bytes.empty()) return;
-      static constexpr std::array<const char*, 3> names{"fuzz.obj", "fuzz.off", "fuzz.stl"};
-      read_mesh(scratch().write(names[static_cast<unsigned char>(bytes[0]) % 3], bytes.substr(1)));
+      static constexpr std::array<const char*, 4> names{"fuzz.obj", "fuzz.off", "fuzz.stl", "fuzz.ply"};
+      read_mesh(scratch().write(names[static_cast<unsigned char>(bytes[0]) % names.size()], bytes.substr(1)));
       return;
     }
     case Reader::EsriGrid:
