@@ -157,6 +157,35 @@ TEST_CASE("killed at every write point and resumed: every output byte-identical 
   CHECK(std::count(names.begin(), names.end(), "step_00004.vtu") == 1);
 }
 
+TEST_CASE("an I/O error at a write point: exit 6 naming it, the last completed iteration saved, --resume completes") {
+  Case fire("faults_io", kFire);
+  auto full = fire.run("full");
+  REQUIRE_MESSAGE(full.exit_code == 0, full.output);
+  struct Point {
+    std::string name;
+    int saved;  ///< the checkpoint the failed run must leave (on_failure's, or the last one written)
+  };
+  // Iteration n is complete once its history row is written: a failure after that (its VTU, the
+  // .pvd, the final files) leaves state n on disk — the driver's on_failure checkpoints it when the
+  // cadence had not; a failure writing row n leaves checkpoint n − 1 (state n is recomputed). The
+  // "checkpoint" point comes after the checkpoint's rename; a failed rename leaves the one before.
+  const std::vector<Point> points = {{"row:2", 1},           {"vtu:2", 2},  {"pvd:2", 2},
+                                     {"rename:history.csv:3", 2}, {"rename:step_00003.vtu:3", 3},
+                                     {"final:5", 5},         {"checkpoint:2", 2}, {"rename:checkpoint.bin:3", 2}};
+  for (const Point& point : points) {
+    CAPTURE(point.name);
+    std::string out = "io-" + point.name;
+    std::replace(out.begin(), out.end(), ':', '-');
+    auto failed = fire.run(out, "--inject-io-error " + point.name);
+    CHECK_MESSAGE(failed.exit_code == 6, failed.output);
+    CHECK_MESSAGE(contains(failed.output, "injected I/O error"), failed.output);
+    CHECK(fire.checkpointed(out) == point.saved);
+    auto resumed = fire.run(out, "--resume");
+    REQUIRE_MESSAGE(resumed.exit_code == 0, resumed.output);
+    check_same_outputs(fire.dir / out, fire.dir / "full");
+  }
+}
+
 TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and the iteration, and the run resumes") {
   Case plane("faults_plugin", kPlane);
   auto reference = plane.run("reference");

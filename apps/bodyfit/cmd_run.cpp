@@ -43,6 +43,7 @@ struct RunArguments {
   bool overwrite = false;  ///< replace a previous run in the output directory (its own files only)
   bool force = false;      ///< --resume with another case than the checkpoint's
   std::string inject_fault;   ///< "POINT:N": SIGKILL at a write point of iteration N (tests; fault_injection.hpp)
+  std::string inject_io_error;  ///< "POINT:N": an IoError there instead
   std::string inject_signal;  ///< "N:INT" or "N:KILL" [":scheduled"]: raise a signal after iteration N (tests)
 };
 
@@ -305,6 +306,7 @@ int run_case(const RunArguments& args) {
   std::signal(SIGINT, on_sigint);
   const InjectedSignal inject = parse_injected_signal(args.inject_signal);
   if (!args.inject_fault.empty()) arm_fault(args.inject_fault);
+  if (!args.inject_io_error.empty()) arm_fault(args.inject_io_error, FaultKind::IoError);
 
   // Set-up writes nothing: a bad case, model, mesh or checkpoint leaves the directory as it was.
   CaseConfig config = read_case(args.case_file, args.sets);
@@ -410,6 +412,7 @@ bodyfit::cli::Command setup_run(CLI::App& app) {
   // Test hooks (no group: hidden from --help): a crash or Ctrl-C at a known point of the run.
   cmd->add_option("--inject-signal", args->inject_signal, "")->group("");
   cmd->add_option("--inject-fault", args->inject_fault, "")->group("");
+  cmd->add_option("--inject-io-error", args->inject_io_error, "")->group("")->excludes("--inject-fault");
   return {cmd, [args]() { return run_case(*args); }};
 }
 

@@ -12,12 +12,13 @@ namespace {
 
 std::atomic<bool> g_armed{false};
 std::string g_point;  // written once by arm_fault, before any thread reaches a point
+FaultKind g_kind = FaultKind::Kill;
 int g_iteration = -1;
 thread_local int t_iteration = -1;
 
 }  // namespace
 
-void arm_fault(const std::string& specification) {
+void arm_fault(const std::string& specification, FaultKind kind) {
   const auto colon = specification.rfind(':');
   int iteration = -1;
   if (colon != std::string::npos && colon > 0) {
@@ -31,6 +32,7 @@ void arm_fault(const std::string& specification) {
                                  specification));
   g_point = specification.substr(0, colon);
   g_iteration = iteration;
+  g_kind = kind;
   g_armed.store(true);
 }
 
@@ -42,7 +44,10 @@ bool fault_armed(std::string_view point) {
 }
 
 void fault_point(std::string_view point) {
-  if (fault_armed(point)) std::raise(SIGKILL);
+  if (!fault_armed(point)) return;
+  if (g_kind == FaultKind::IoError)
+    throw IoError(fmt::format("{}: injected I/O error at iteration {} (--inject-io-error)", point, t_iteration));
+  std::raise(SIGKILL);
 }
 
 }  // namespace bodyfit
