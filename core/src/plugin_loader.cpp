@@ -149,7 +149,10 @@ LoadedModel load_plugin_file(const fs::path& file) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw file_error(file, "no such plugin file");
   dlerror();
-  HandleGuard guard{dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL)};
+  // Never unloaded (RTLD_NODELETE; dlclose only drops the count): what a plugin pulls in may not
+  // survive an unload — libgomp, through the thermal plugin's CHOLMOD, keeps a block that an unload
+  // leaks (LeakSanitizer, the sanitize stage) and thread-exit hooks into its unmapped code.
+  HandleGuard guard{dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE)};
   if (!guard.handle) throw file_error(file, "cannot load plugin: " + dl_error());
 
   // The ABI first: nothing else of a plugin built against other headers may be trusted.
