@@ -6,16 +6,15 @@
 #   fuzz      each libFuzzer target of tests/fuzz for BODYFIT_FUZZ_SECONDS seconds (default 30) from
 #             its seed corpus (scripts/run_fuzzers.sh).
 # Any failure, sanitizer report or fuzzer finding fails the run. docs/testing.md has the details.
-#   usage: scripts/run_tests.sh [--stages release,sanitize,fuzz]   (default: release; CI runs the
-#   default until the whole suite has been seen to pass under the sanitizers, docs/testing.md)
+#   usage: scripts/run_tests.sh [--stages release,sanitize,fuzz]   (default: all three, what CI runs)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 JOBS="${BODYFIT_JOBS:-$(nproc)}"
-stages="release"
+stages="release,sanitize,fuzz"
 case "${1:-}" in
   "") ;;
   --stages) stages="${2:?--stages needs a value, e.g. release,sanitize}" ;;
-  -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h|--help) sed -n '2,9p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   *) echo "run_tests.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
 esac
 for s in ${stages//,/ }; do
