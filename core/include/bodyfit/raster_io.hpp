@@ -12,15 +12,16 @@
 
 namespace bodyfit {
 
-/// What a raster's values are, for its readers.
+/// What a raster's values are, for its readers. Every member has a default, so designated
+/// initializers may name any subset ({.units = "s"}) without -Wmissing-field-initializers.
 struct RasterMetadata {
-  std::string units;        ///< of the values, e.g. "s" or "m/s" ("" when none)
-  std::string description;  ///< e.g. "fire arrival time, seconds after 2026-07-14T13:00:00Z"
+  std::string units{};      ///< of the values, e.g. "s" or "m/s" ("" when none)
+  std::string description{};  ///< e.g. "fire arrival time, seconds after 2026-07-14T13:00:00Z"
   /// The NODATA value written (cells that are NaN or equal grid.nodata become it); default grid.nodata.
-  std::optional<double> nodata;
+  std::optional<double> nodata{};
   /// Further KEY=value items of the GeoTIFF's metadata (e.g. {"START_TIME", "2026-07-14T13:00:00Z"});
   /// an ESRI grid has no place for them.
-  std::vector<std::pair<std::string, std::string>> items;
+  std::vector<std::pair<std::string, std::string>> items{};
 };
 
 /// Write `grid` to `file`, in the format its extension names: `.asc` an ESRI ASCII grid (and a
