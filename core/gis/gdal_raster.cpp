@@ -1,5 +1,6 @@
 // The GDAL module (see core/src/gis_module.hpp): rasters and coordinate systems through GDAL/OSR.
 #include "gis_module.hpp"
+#include "gdal_vector.hpp"
 
 #include <cpl_error.h>
 #include <gdal.h>
@@ -150,7 +151,9 @@ bool write_geotiff(const std::filesystem::path& file, const HeightGrid& grid, do
 }
 
 const Api kApi{.version = kApiVersion, .read_raster = read_raster, .describe_crs = describe_crs, .same_crs = same_crs,
-                  .write_geotiff = write_geotiff};
+                  .write_geotiff = write_geotiff,
+                  .read_vector = read_vector,
+                  .write_polygons = write_polygons};
 
 }  // namespace
 }  // namespace bodyfit::gis

@@ -7,6 +7,7 @@
 // GIS functions do, under one exported symbol.
 #include <bodyfit/generators.hpp>
 #include <bodyfit/raster_io.hpp>
+#include <bodyfit/vector_io.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -40,6 +41,13 @@ struct Api {
   /// metadata; false with `error` set when GDAL cannot write it. (version 2)
   bool (*write_geotiff)(const std::filesystem::path& file, const HeightGrid& grid, double nodata,
                         const RasterMetadata& metadata, std::string& error) = nullptr;
+  /// The first layer of a vector file (OGR), each feature's validity by OGR_G_IsValid; false with
+  /// `error` set when OGR cannot read it. (version 2)
+  bool (*read_vector)(const std::filesystem::path& file, VectorLayer& layer, std::string& error) = nullptr;
+  /// A layer of MultiPolygons created at `file` with the OGR driver `driver` ("GPKG", "GeoJSON");
+  /// false with `error` set on failure. (version 2)
+  bool (*write_polygons)(const std::filesystem::path& file, const std::string& driver, const VectorLayer& layer,
+                         std::string& error) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built
