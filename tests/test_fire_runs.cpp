@@ -3,12 +3,17 @@
 #include "fire_maps.hpp"
 
 #include <bodyfit/case_config.hpp>
+#include <bodyfit/config.hpp>
+#include <bodyfit/io.hpp>
+#include <bodyfit/plan_geometry.hpp>
+#include <bodyfit/vector_io.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
 
+#include "gis_module.hpp"
 #include "test_support.hpp"
 
 #include <fmt/format.h>
@@ -166,7 +171,7 @@ TEST_CASE("narrow-band sub-steps: the whole-surface computation's front and arri
   for (std::size_t r = 0; r < grid.rows; ++r)
     for (std::size_t c = 0; c < grid.cols; ++c)
       grid.heights[r * grid.cols + c] = 60 * std::sin(double(c) * h / 170) * std::cos(double(r) * h / 230);
-  const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
+  const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n[arrival]\nformat = 'asc'\n";
   test::TempDir dir_band("fire_band"), dir_whole("fire_whole");
   FireRun band = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 120, 3, dir_band.path(), 0.05, 1.0);
   FireRun whole =
@@ -234,7 +239,7 @@ TEST_CASE("a run on a DEM read from an ESRI ASCII grid writes arrival times") {
     }
   }
   SurfaceMesh terrain = make_terrain_from_grid(read_esri_ascii(dir / "hill.asc"), 25);
-  FireRun run = burn(std::move(terrain), {{300, 300, 100}}, "[arrival]\ncell_size = 25.0\n", 30, 10, dir.path());
+  FireRun run = burn(std::move(terrain), {{300, 300, 100}}, "[arrival]\ncell_size = 25.0\nformat = 'asc'\n", 30, 10, dir.path());
   REQUIRE(run.result.records.size() == 10);
   CHECK(run.result.records.back().area > run.result.records.front().area);
   HeightGrid arrival = read_raw_grid(dir / "arrival_time.asc");
@@ -324,7 +329,7 @@ TEST_CASE("[model] file names are relative to the case file: a run from another 
   auto first = test::run_bodyfit("run ../case/case.toml -o out --set time.iterations=2");
   INFO(first.output);
   CHECK(first.exit_code == 0);
-  CHECK(fs::exists(dir / "elsewhere" / "out" / "arrival_time.asc"));
+  CHECK(fs::exists(dir / "elsewhere" / "out" / (config::have_gdal ? "arrival_time.tif" : "arrival_time.asc")));
   CHECK(history_rows().size() == 4);  // header, states 0..2
 
   // --resume reads the case given on its command line again: from a third directory, same files.
@@ -342,4 +347,80 @@ TEST_CASE("[model] file names are relative to the case file: a run from another 
   INFO(missing.output);
   CHECK(missing.exit_code == 1);
   CHECK(missing.output.find((fs::absolute(dir / "case") / "maps" / "nope.asc").string()) != std::string::npos);
+}
+
+TEST_CASE("GIS outputs of a run: arrival time and rate of spread as GeoTIFF, perimeters as a GeoPackage") {
+  if constexpr (!config::have_gdal) return;
+  namespace fs = std::filesystem;
+  test::TempDir dir("fire_gis_outputs");
+  // A tilted plane on a DEM in UTM zone 32N (the .prj of the Luxembourg DEM), 20 m cells.
+  {
+    std::ofstream out(dir / "slope.asc");
+    out << "ncols 41\nnrows 41\nxllcorner 300000\nyllcorner 5500000\ncellsize 20\nNODATA_value -9999\n";
+    for (int r = 0; r < 41; ++r)
+      for (int c = 0; c < 41; ++c) out << 0.2 * (c + 0.5) * 20 << (c < 40 ? " " : "\n");
+  }
+  fs::copy_file(test::source_path("meshes/dem/luxembourg_elev_200m.prj"), dir / "slope.prj");
+  std::ofstream(dir / "case.toml")
+      << "[surface]\ngenerator = \"terrain\"\ndem = \"slope.asc\"\nh = 20.0\n"
+      << "[region]\nshape = \"disks\"\ncenters = [[300300.0, 5500400.0]]\nradii = [100.0]\n"
+      << "[model]\nname = \"fire\"\narrival = { like = \"slope.asc\" }\n"
+      << "[time]\ndt = 30.0\niterations = 4\nstart = \"2026-07-14T15:00:00+02:00\"\n[output]\nvtu_every = 0\n";
+  const auto result = test::run_bodyfit("run '" + (dir / "case.toml").string() + "' -o '" + (dir / "out").string() + "'");
+  INFO(result.output);
+  REQUIRE(result.exit_code == 0);
+  const fs::path out = dir / "out";
+  const HeightGrid dem = read_esri_ascii(dir / "slope.asc");
+  const gis::Api& gis = gis::module_for(out);
+
+  // The rasters: the DEM's frame and CRS, NODATA where nothing burnt, times and rates in range.
+  HeightGrid arrival, rate;
+  std::string error;
+  REQUIRE(gis.read_raster(out / "arrival_time.tif", arrival, error));
+  REQUIRE(gis.read_raster(out / "rate_of_spread.tif", rate, error));
+  for (const HeightGrid* g : {&arrival, &rate}) {
+    CHECK(g->cols == dem.cols);
+    CHECK(g->rows == dem.rows);
+    CHECK(g->x_origin == dem.x_origin);
+    CHECK(g->y_origin == dem.y_origin);
+    CHECK(g->nodata == -9999);
+    CHECK(gis.same_crs(g->crs, dem.crs));
+  }
+  CHECK(fire::raster_nearest(arrival, 300300, 5500400) == 0);
+  CHECK(fire::raster_nearest(rate, 300300, 5500400) == -9999);  // burning at the start: no spread
+  CHECK(fire::raster_nearest(arrival, 300790, 5500010) == -9999);  // never reached
+  const fire::BalbiParameters p;
+  std::size_t spread = 0;
+  for (std::size_t i = 0; i < arrival.heights.size(); ++i) {
+    const double t = arrival.heights[i], r = rate.heights[i];
+    if (t == -9999) CHECK(r == -9999);
+    if (t > 0) {
+      ++spread;
+      CHECK(t <= 120);
+      CHECK(r >= p.R0 * 0.999);  // flat across the slope, faster uphill
+      CHECK(r <= fire::rate_of_spread(std::atan(0.2), p) * 1.001);
+    }
+  }
+  CHECK(spread > 20);
+
+  // The perimeters: one feature per state (0 to 4), valid, their planar areas the mesh's.
+  const VectorLayer layer = read_vector_layer(out / "perimeters.gpkg");
+  REQUIRE(layer.features.size() == 5);
+  CHECK(gis.same_crs(layer.crs, dem.crs));
+  double previous = 0;
+  for (std::size_t k = 0; k < layer.features.size(); ++k) {
+    const VectorFeature& f = layer.features[k];
+    CHECK(f.valid);
+    CHECK(std::get<std::int64_t>(f.attribute("iteration")) == std::int64_t(k));
+    CHECK(std::get<double>(f.attribute("time")) == doctest::Approx(30.0 * double(k)));
+    CHECK(std::get<std::string>(f.attribute("datetime")) == fmt::format("2026-07-14T13:0{}:{:02}Z", k / 2, 30 * (k % 2)));
+    double area = 0;
+    for (const auto& polygon : f.geometry.polygons) area += polygon_area(polygon);
+    CHECK(std::get<double>(f.attribute("area")) == doctest::Approx(area).epsilon(1e-12));
+    CHECK(area > previous);
+    previous = area;
+  }
+  const SurfaceMesh final_mesh = read_mesh(out / "final.mesh");
+  const double final_area = region_plan_area(final_mesh);
+  CHECK(std::abs(previous - final_area) <= 1e-9 * final_area);
 }

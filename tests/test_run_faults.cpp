@@ -21,7 +21,9 @@ namespace fs = std::filesystem;
 namespace {
 
 // A fire on a small procedural terrain, 5 steps of which the last is shortened (200 s of 600),
-// every output on: a VTU per state, a checkpoint per iteration, the arrival-time raster.
+// every output on: a VTU per state, a checkpoint per iteration, the arrival-time and rate rasters
+// (ESRI grids) and the perimeters (GeoJSON: text a byte comparison can hold, where a GeoPackage
+// records the time it was written).
 const char* kFire = R"(
 [surface]
 generator = "terrain"
@@ -39,6 +41,9 @@ name = "fire"
 preset = "balbi2009"
 [model.arrival]
 cell_size = 200.0
+format = "asc"
+[model.perimeters]
+file = "perimeters.geojson"
 [time]
 dt = 600.0
 final_time = 2600.0
@@ -120,7 +125,7 @@ TEST_CASE("killed at every write point and resumed: every output byte-identical 
   REQUIRE(fire.checkpointed("full") == 5);
   // The driver's points (between two files), then every atomic write between its temporary and
   // the rename: the checkpoint (written in the background), the history, the .pvd, a VTU, the final
-  // mesh and φ, the model's raster, the effective case.
+  // mesh and φ, the model's rasters and perimeters, the effective case.
   const std::vector<std::string> points = {
       "checkpoint:0",  // the first checkpoint on disk, history.csv not yet
       "row:2",         // a history row without its checkpoint
@@ -130,6 +135,7 @@ TEST_CASE("killed at every write point and resumed: every output byte-identical 
       "rename:checkpoint.bin:0", "rename:checkpoint.bin:3", "rename:history.csv:1", "rename:history.csv:3",
       "rename:series.pvd:0",     "rename:series.pvd:4",     "rename:step_00003.vtu:3",
       "rename:final.mesh:5",     "rename:final.sol:5",      "rename:arrival_time.asc:5",
+      "rename:rate_of_spread.asc:5", "rename:perimeters.geojson:3", "rename:perimeters.geojson:5",
       "rename:case.toml:0"};
   for (const std::string& point : points) {
     CAPTURE(point);

@@ -204,7 +204,7 @@ TEST_CASE("StepContext: state, cached geometry and helpers") {
   SurfaceMesh sphere = make_sphere({.faces = 1280});
   ScalarField d = field(sphere, [](const Vec3& p) { return p[2]; });
   StepContext context = StepContext::standalone(
-      sphere, d, {.time = 1.5, .dt = 0.25, .iteration = 7, .output_dir = "out", .terrain = false});
+      sphere, d, {.time = 1.5, .dt = 0.25, .iteration = 7, .output_dir = "out", .terrain = false, .clock_start = {}});
   CHECK(&context.mesh() == &sphere);
   CHECK(&context.distance() == &d);
   CHECK(context.time() == 1.5);

@@ -1,5 +1,6 @@
 // The GDAL module (see core/src/gis_module.hpp): rasters and coordinate systems through GDAL/OSR.
 #include "gis_module.hpp"
+#include "gdal_vector.hpp"
 
 #include <cpl_error.h>
 #include <gdal.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <vector>
 
 namespace bodyfit::gis {
 namespace {
@@ -94,7 +96,64 @@ bool same_crs(const std::string& a, const std::string& b) {
   return x.parse(a) && y.parse(b) && OSRIsSame(x.h, y.h) != 0;
 }
 
-const Api kApi{.version = kApiVersion, .read_raster = read_raster, .describe_crs = describe_crs, .same_crs = same_crs};
+// A GeoTIFF a GIS reads as it is: north-up, the CRS in its GeoKeys, NODATA in its tag, units and
+// description on the band and in the dataset's metadata; DEFLATE with the floating-point
+// predictor (arrival-time rasters shrink several times).
+bool write_geotiff(const std::filesystem::path& file, const HeightGrid& grid, double nodata,
+                   const RasterMetadata& metadata, std::string& error) {
+  GDALAllRegister();
+  GDALDriverH driver = GDALGetDriverByName("GTiff");
+  if (!driver) {
+    error = "GDAL has no GTiff driver";
+    return false;
+  }
+  Srs srs;
+  if (!grid.crs.empty() && !srs.parse(grid.crs)) {
+    error = fmt::format("cannot read the coordinate system to write (GDAL: {})", CPLGetLastErrorMsg());
+    return false;
+  }
+  const char* options[] = {"COMPRESS=DEFLATE", "PREDICTOR=3", "TILED=YES", nullptr};
+  CPLErrorReset();
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  GDALDatasetH dataset = GDALCreate(driver, file.c_str(), int(grid.cols), int(grid.rows), 1, GDT_Float64,
+                                    const_cast<char**>(options));
+  CPLPopErrorHandler();
+  if (!dataset) {
+    error = fmt::format("cannot create the GeoTIFF (GDAL: {})", CPLGetLastErrorMsg());
+    return false;
+  }
+  double gt[6] = {grid.x_origin, grid.cell_size, 0, grid.y_origin + double(grid.rows) * grid.cell_size, 0,
+                  -grid.cell_size};
+  GDALSetGeoTransform(dataset, gt);
+  if (!grid.crs.empty()) GDALSetSpatialRef(dataset, srs.h);
+  GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
+  GDALSetRasterNoDataValue(band, nodata);
+  if (!metadata.units.empty()) {
+    GDALSetRasterUnitType(band, metadata.units.c_str());
+    GDALSetMetadataItem(dataset, "UNITS", metadata.units.c_str(), nullptr);
+  }
+  if (!metadata.description.empty()) {
+    GDALSetDescription(band, metadata.description.c_str());
+    GDALSetMetadataItem(dataset, "DESCRIPTION", metadata.description.c_str(), nullptr);
+  }
+  for (const auto& [key, value] : metadata.items) GDALSetMetadataItem(dataset, key.c_str(), value.c_str(), nullptr);
+  std::vector<double> values = grid.heights;
+  for (double& v : values)
+    if (std::isnan(v) || v == grid.nodata) v = nodata;
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  bool ok = GDALRasterIO(band, GF_Write, 0, 0, int(grid.cols), int(grid.rows), values.data(), int(grid.cols),
+                         int(grid.rows), GDT_Float64, 0, 0) == CE_None;
+  GDALClose(dataset);  // flushes: a full disk shows here
+  ok = ok && CPLGetLastErrorType() < CE_Failure;
+  CPLPopErrorHandler();
+  if (!ok) error = fmt::format("cannot write the GeoTIFF (GDAL: {})", CPLGetLastErrorMsg());
+  return ok;
+}
+
+const Api kApi{.version = kApiVersion, .read_raster = read_raster, .describe_crs = describe_crs, .same_crs = same_crs,
+                  .write_geotiff = write_geotiff,
+                  .read_vector = read_vector,
+                  .write_polygons = write_polygons};
 
 }  // namespace
 }  // namespace bodyfit::gis

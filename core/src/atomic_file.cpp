@@ -13,21 +13,15 @@
 
 namespace bodyfit {
 
-void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write) {
+void write_atomically_at(const std::filesystem::path& target,
+                         const std::function<void(const std::filesystem::path& temporary)>& write) {
   namespace fs = std::filesystem;
   static std::atomic<unsigned> counter{0};
   fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw write_error(target, "cannot write: directory does not exist");
   fs::path temp = dir / fmt::format(".{}.tmp{}-{}", target.filename().string(), ::getpid(), counter++);
   try {
-    {
-      std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-      if (!out)
-        throw write_error(target, fmt::format("cannot write in {} ({})", dir.string(), std::strerror(errno)));
-      write(out);
-      out.flush();
-      if (!out) throw write_error(target, "write failed (disk full?)");
-    }
+    write(temp);
     fault_point("rename:" + target.filename().string());  // a crash between the write and the rename
     std::error_code ec;
     fs::rename(temp, target, ec);
@@ -37,6 +31,17 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
     fs::remove(temp, ignored);
     throw;
   }
+}
+
+void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write) {
+  write_atomically_at(target, [&](const std::filesystem::path& temp) {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out)
+      throw write_error(target, fmt::format("cannot write in {} ({})", temp.parent_path().string(), std::strerror(errno)));
+    write(out);
+    out.flush();
+    if (!out) throw write_error(target, "write failed (disk full?)");
+  });
 }
 
 bool is_atomic_temporary(const std::string& file_name) {

@@ -1,6 +1,7 @@
 // Reading a run case: --set overrides, then every table validated through bodyfit::Parameters
 // into a CaseConfig. Setting up the run from it is case_setup.cpp.
 #include <bodyfit/case_config.hpp>
+#include <bodyfit/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
 #include <bodyfit/parameters.hpp>
@@ -96,7 +97,7 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
   if (!table.contains("region")) throw InputError("missing table [region] (shape = refs|sol|cap|disks)");
   Parameters p(table["region"].as_table(), "region");
   if (!p.has("shape")) p.fail("missing key 'shape' (refs, sol, cap or disks)");
-  const std::string shape = p.choice("shape", "", {"refs", "sol", "cap", "disks", "balls"});
+  const std::string shape = p.choice("shape", "", {"refs", "sol", "cap", "disks", "balls", "ignitions"});
   if (shape == "refs") {
     out.kind = RegionSpec::Kind::Refs;
     // Integers that fit an int (converting 1e300 to int was undefined: found by fuzz_case).
@@ -143,6 +144,14 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
       out.caps.emplace_back(out.axis, out.angle);
     }
     p.forbid({"refs", "sol", "centers", "radii"}, "to shape 'cap'");
+  } else if (shape == "ignitions") {
+    out.kind = RegionSpec::Kind::Ignitions;
+    p.accept("file");
+    if (!p.has("file")) p.fail("shape 'ignitions': missing key 'file' (a vector layer: .geojson, .shp, .gpkg)");
+    out.ignitions = resolve(base_dir, p.string("file", ""));
+    out.ignition_radius = p.number("radius", 0, {.min = 0});
+    out.time_attribute = p.string("time_attribute", "");
+    p.forbid({"refs", "sol", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'ignitions'");
   } else if (shape == "balls") {
     out.kind = RegionSpec::Kind::Balls;
     const auto centers = p.number_arrays("centers", 3);
@@ -188,6 +197,14 @@ void parse_time(const toml::table& table, TimeSpec& out) {
   out.final_time = p.number("final_time", out.final_time, kPositive);
   out.iterations = long(p.integer("iterations", -1, 0));
   out.max_rejections = clamp_to_int(p.integer("max_rejections", out.max_rejections, 0));
+  out.start = p.string("start", "");
+  if (p.has("start")) {
+    out.start_seconds = parse_iso8601(out.start);
+    if (!out.start_seconds)
+      p.fail("start", fmt::format("'{}' is not an ISO 8601 date-time with its zone (e.g. \"2026-07-14T13:00:00Z\", or "
+                                  "\"2026-07-14T15:00:00+02:00\")",
+                                  out.start));
+  }
   p.reject_unknown();  // first: a misspelt key often explains a missing one
   if ((out.dt > 0) == (out.cfl > 0)) p.fail("give exactly one of 'dt' and 'cfl'");
   if (!p.has("final_time") && !p.has("iterations")) p.fail("give 'final_time' or 'iterations' (or both)");

@@ -1,21 +1,97 @@
 // Setting up a run from a validated case: the surface S, its reference for the remesher, the
 // initial region G(0) meshed into T^0, and the evolution options.
 #include <bodyfit/case_config.hpp>
+#include <bodyfit/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/projection.hpp>
+#include <bodyfit/vector_io.hpp>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 namespace bodyfit {
+namespace {
+
+/// One feature of an ignition layer: where, in plan view, and when (seconds after t = 0).
+struct Ignition {
+  PlanGeometry shape;
+  double time = 0;
+};
+
+/// The ignition time of a feature: a number of seconds, a text holding one, or an ISO 8601
+/// date-time (with [time] start); null or absent: 0.
+double ignition_time(const CaseConfig& config, const AttributeValue& value, std::size_t feature) {
+  const auto& file = config.region.ignitions;
+  if (const auto* integer = std::get_if<std::int64_t>(&value)) return double(*integer);
+  if (const auto* real = std::get_if<double>(&value)) {
+    if (!std::isfinite(*real)) throw file_error(file, fmt::format("feature {}: ignition time {} is not finite", feature, *real));
+    return *real;
+  }
+  if (const auto* text = std::get_if<std::string>(&value)) {
+    double seconds = 0;
+    const char* end = text->data() + text->size();
+    if (auto [ptr, ec] = std::from_chars(text->data(), end, seconds); ec == std::errc() && ptr == end && std::isfinite(seconds))
+      return seconds;
+    const auto clock = parse_iso8601(*text);
+    if (!clock)
+      throw file_error(file, fmt::format("feature {}: ignition time '{}' is neither seconds nor an ISO 8601 date-time "
+                                         "with its zone (e.g. 2026-07-14T15:30:00Z)",
+                                         feature, *text));
+    if (!config.time.start_seconds)
+      throw file_error(file, fmt::format("feature {}: ignition time '{}' is a date-time, and the case gives no [time] "
+                                         "start to count from",
+                                         feature, *text));
+    return *clock - *config.time.start_seconds;
+  }
+  return 0;
+}
+
+/// The features of [region] file, checked: a projected coordinate system (the DEM's when the
+/// surface is one), a radius for points and lines, ignition times.
+std::vector<Ignition> read_ignitions(const CaseConfig& config) {
+  const auto& r = config.region;
+  const VectorLayer layer = read_vector_layer(r.ignitions);
+  if (!layer.crs.empty()) {
+    HeightGrid as_grid;  // require_same_crs compares rasters' CRS: the layer's as one
+    as_grid.crs = layer.crs;
+    if (!config.surface.dem.empty()) require_same_crs(read_dem(config.surface.dem), config.surface.dem, as_grid, r.ignitions);
+  }
+  std::vector<Ignition> ignitions;
+  for (std::size_t i = 0; i < layer.features.size(); ++i) {
+    const VectorFeature& f = layer.features[i];
+    if (f.geometry.empty()) continue;  // a feature without geometry ignites nothing
+    if ((!f.geometry.points.empty() || !f.geometry.lines.empty()) && !(r.ignition_radius > 0))
+      throw InputError(fmt::format("[region] radius: feature {} of {} has points or lines, which ignite disks and "
+                                   "buffers of a radius: give radius > 0 (metres)",
+                                   i + 1, r.ignitions.string()));
+    const AttributeValue none;
+    const double time = ignition_time(config, r.time_attribute.empty() ? none : f.attribute(r.time_attribute), i + 1);
+    ignitions.push_back({f.geometry, time});
+  }
+  if (ignitions.empty()) throw file_error(r.ignitions, "no feature with a geometry: nothing ignites");
+  return ignitions;
+}
+
+/// Distance in plan view to the ignited shape, negative inside: disks round points, buffers round
+/// lines, polygons as they are.
+double ignition_level_set(const PlanGeometry& shape, double radius, const Vec3& p) {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& point : shape.points) d = std::min(d, std::hypot(p[0] - point[0], p[1] - point[1]) - radius);
+  for (const auto& line : shape.lines) d = std::min(d, distance_to_path(line, p[0], p[1], false) - radius);
+  for (const auto& polygon : shape.polygons) d = std::min(d, signed_distance_to_polygon(polygon, p[0], p[1]));
+  return d;
+}
+
+}  // namespace
 
 SurfaceMesh make_case_surface(const CaseConfig& config) {
   const auto& s = config.surface;
@@ -62,6 +138,26 @@ ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surfa
         const Vec3& p = surface.point(v);
         double d = std::numeric_limits<double>::infinity();
         for (const auto& [cx, cy, cz, radius] : r.balls) d = std::min(d, (p - Vec3(cx, cy, cz)).norm() - radius);
+        phi[v.idx()] = d;
+      }
+      return phi;
+    }
+    case RegionSpec::Kind::Ignitions: {
+      // G(0): the features igniting at t ≤ 0; the others join later (setup_case's additions).
+      std::vector<Ignition> at_start;
+      double first = std::numeric_limits<double>::infinity();
+      for (auto& ignition : read_ignitions(config)) {
+        first = std::min(first, ignition.time);
+        if (ignition.time <= 0) at_start.push_back(std::move(ignition));
+      }
+      if (at_start.empty())
+        throw file_error(r.ignitions, fmt::format("no feature ignites at t = 0 (the first at t = {} s): a run starts "
+                                                  "burning; move [time] start to the first ignition",
+                                                  first));
+      for (auto v : surface.vertices()) {
+        double d = std::numeric_limits<double>::infinity();
+        for (const auto& ignition : at_start)
+          d = std::min(d, ignition_level_set(ignition.shape, r.ignition_radius, surface.point(v)));
         phi[v.idx()] = d;
       }
       return phi;
@@ -125,6 +221,15 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.advection = config.advection;
   options.discretize = config.discretize;
   options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
+  options.clock_start = config.time.start_seconds;
+  if (config.region.kind == RegionSpec::Kind::Ignitions)
+    for (auto& ignition : read_ignitions(config))
+      if (ignition.time > 0)
+        options.additions.push_back(
+            {.time = ignition.time,
+             .level_set = [shape = std::move(ignition.shape), radius = config.region.ignition_radius](const Vec3& p) {
+               return ignition_level_set(shape, radius, p);
+             }});
   return setup;
 }
 

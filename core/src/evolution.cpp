@@ -134,6 +134,8 @@ class Evolution {
   void advance() {
     double step = dt_;
     if (options_.final_time - t_ < dt_ + tiny()) step = options_.final_time - t_;  // land exactly on T
+    for (const auto& region : options_.additions)  // and on the time a region joins G
+      if (region.time - t_ > tiny() && region.time - t_ < step - tiny()) step = region.time - t_;
     // T^n and d^n are kept only for a model that may reject (a copy of the mesh).
     std::optional<SurfaceMesh> kept_mesh;
     ScalarField kept_distance;
@@ -374,11 +376,14 @@ class Evolution {
   void accept(const LevelSetStep& step, Review review, double nominal_dt, int attempt) {
     candidate_ = false;  // T^{n+1} is the state now
     ++n_;
+    const double before = t_;
     t_ += step.done;
+    StageTimes ms = step.ms;
+    add_scheduled_regions(before, ms);
     if (review.next_dt > 0) dt_ = review.next_dt;
     IterationRecord record = measure_state(mesh_, n_, t_);
     record.dt = nominal_dt / std::ldexp(1.0, attempt);
-    record.ms = step.ms;
+    record.ms = ms;
     record.substeps = step.substeps;
     record.rejections = rejections_;
     rejections_ = 0;
@@ -390,6 +395,31 @@ class Evolution {
     if (hooks_.log) log(record);
     result_.records.push_back(std::move(record));
     if (review.stop) stop(StopReason::ModelStop, review.reason.empty() ? "the model stopped the run" : review.reason);
+  }
+
+  /// The regions whose time came within (before, t_] joined to the accepted state: φ = min(d, ψ)
+  /// cut into it and remeshed (EvolutionOptions::additions).
+  void add_scheduled_regions(double before, StageTimes& ms) {
+    std::vector<const ScheduledRegion*> due;
+    for (const auto& region : options_.additions)
+      if (region.time - before > tiny() && region.time - t_ <= tiny()) due.push_back(&region);
+    if (due.empty()) return;
+    Stopwatch clock;
+    ScalarField phi = distance_;
+    for (auto v : mesh_.vertices())
+      for (const ScheduledRegion* region : due) phi[v.idx()] = std::min(phi[v.idx()], region->level_set(mesh_.point(v)));
+    model_.end_step(StepOutcome{mesh_, distance_, phi, t_, 0.0, 0});
+    ms.velocity += clock.lap_ms();
+    candidate_ = true;  // until remeshed, the mesh is neither T^{n+1} nor its union
+    discretize(mesh_, phi, options_.discretize);
+    ms.discretize += clock.lap_ms();
+    remesh(mesh_, options_.remesh);
+    if (options_.canonical_order) canonicalize(mesh_);
+    ms.remesh += clock.lap_ms();
+    measure_distance();
+    ms.distance += clock.lap_ms();
+    candidate_ = false;
+    if (hooks_.log) spdlog::info("n={} t={:.5g}: {} region(s) joined G", n_, t_, due.size());
   }
 
   EvolutionResult finish() {
@@ -438,6 +468,7 @@ class Evolution {
                                        .iteration = iteration,
                                        .output_dir = options_.output_dir,
                                        .terrain = options_.terrain,
+                                       .clock_start = options_.clock_start,
                                        .active = active,
                                        .geometry = geometry});
   }

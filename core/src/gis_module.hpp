@@ -6,6 +6,8 @@
 // sources and headers, so C++ types cross the boundary; the table of entry points grows as the
 // GIS functions do, under one exported symbol.
 #include <bodyfit/generators.hpp>
+#include <bodyfit/raster_io.hpp>
+#include <bodyfit/vector_io.hpp>
 
 #include <cstdint>
 #include <filesystem>
@@ -13,7 +15,7 @@
 
 namespace bodyfit::gis {
 
-inline constexpr std::uint32_t kApiVersion = 1;
+inline constexpr std::uint32_t kApiVersion = 2;
 
 /// What bodyfit needs to know of a coordinate system.
 struct CrsInfo {
@@ -34,6 +36,18 @@ struct Api {
   bool (*describe_crs)(const std::string& wkt, CrsInfo& info, std::string& error) = nullptr;
   /// Whether two WKT texts describe the same coordinate system.
   bool (*same_crs)(const std::string& a, const std::string& b) = nullptr;
+  /// `grid` as a GeoTIFF at `file` (created there: the caller makes it atomic), with the CRS of
+  /// grid.crs, the NODATA value `nodata` (NaN cells and grid.nodata cells become it) and the
+  /// metadata; false with `error` set when GDAL cannot write it. (version 2)
+  bool (*write_geotiff)(const std::filesystem::path& file, const HeightGrid& grid, double nodata,
+                        const RasterMetadata& metadata, std::string& error) = nullptr;
+  /// The first layer of a vector file (OGR), each feature's validity by OGR_G_IsValid; false with
+  /// `error` set when OGR cannot read it. (version 2)
+  bool (*read_vector)(const std::filesystem::path& file, VectorLayer& layer, std::string& error) = nullptr;
+  /// A layer of MultiPolygons created at `file` with the OGR driver `driver` ("GPKG", "GeoJSON");
+  /// false with `error` set on failure. (version 2)
+  bool (*write_polygons)(const std::filesystem::path& file, const std::string& driver, const VectorLayer& layer,
+                         std::string& error) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built

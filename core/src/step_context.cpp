@@ -76,6 +76,7 @@ StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& 
                                      .iteration = where.iteration,
                                      .output_dir = where.output_dir,
                                      .terrain = where.terrain,
+                                     .clock_start = where.clock_start,
                                      .active = {},
                                      .geometry = nullptr});
 }
@@ -88,6 +89,7 @@ int StepContext::iteration() const { return impl_->state.iteration; }
 const std::filesystem::path& StepContext::output_dir() const { return impl_->state.output_dir; }
 bool StepContext::is_terrain() const { return impl_->state.terrain; }
 std::span<const int> StepContext::active_vertices() const { return impl_->state.active; }
+std::optional<double> StepContext::clock_start() const { return impl_->state.clock_start; }
 
 double StepContext::mesh_size() const {
   std::lock_guard lock(impl_->mutex);

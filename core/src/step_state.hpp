@@ -22,6 +22,7 @@ struct StepState {
   int iteration = 0;
   std::filesystem::path output_dir;
   bool terrain = false;                   ///< S is a height field z(x, y)
+  std::optional<double> clock_start;      ///< seconds since the epoch at t = 0 ([time] start)
   std::span<const int> active;            ///< narrow band: where V is needed (empty: every vertex)
   StepGeometry* geometry = nullptr;       ///< shared with the other contexts of the step (optional)
 };

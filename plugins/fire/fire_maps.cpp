@@ -99,6 +99,7 @@ void ArrivalRaster::initialise(const SurfaceMesh& mesh, double cell_size, const 
   }
   grid_.nodata = -9999;
   grid_.heights.assign(grid_.cols * grid_.rows, std::numeric_limits<double>::quiet_NaN());
+  rate_ = grid_;
 }
 
 void ArrivalRaster::save(ModelState& state) const {
@@ -106,6 +107,7 @@ void ArrivalRaster::save(ModelState& state) const {
   state.set("arrival.size", std::vector<std::int64_t>{std::int64_t(grid_.cols), std::int64_t(grid_.rows)});
   state.set("arrival.frame", std::vector<double>{grid_.x_origin, grid_.y_origin, grid_.cell_size, grid_.nodata});
   state.set("arrival.times", grid_.heights);
+  state.set("arrival.rates", rate_.heights);
 }
 
 void ArrivalRaster::load(const ModelState& state) {
@@ -121,20 +123,31 @@ void ArrivalRaster::load(const ModelState& state) {
   grid_.rows = std::size_t(size[1]);
   grid_.x_origin = frame[0], grid_.y_origin = frame[1], grid_.cell_size = frame[2], grid_.nodata = frame[3];
   grid_.heights = times;
+  rate_ = grid_;
+  // States written before the rate raster existed have none: those rates stay unknown (NaN).
+  if (state.has("arrival.rates") && state.numbers("arrival.rates").size() == times.size())
+    rate_.heights = state.numbers("arrival.rates");
+  else
+    rate_.heights.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
   swept_ = true;  // the state comes from a run past its first update
 }
 
 void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next,
-                           double time, double dt, std::span<const int> changed) {
+                           double time, double dt, std::span<const int> changed, const ScalarField* speed) {
   auto reach = [&](double& arrival, FaceHandle f, const std::array<double, 3>& bary) {
     auto vs = face_vertices(mesh, f);
-    double d = 0, phi = 0;
+    double d = 0, phi = 0, rate = 0;
     for (int k = 0; k < 3; ++k) {
       d += bary[k] * distance[vs[k].idx()];
       phi += bary[k] * phi_next[vs[k].idx()];
+      if (speed) rate += bary[k] * (*speed)[vs[k].idx()];
     }
-    if (d <= 0) arrival = time;  // already burnt at t^n (the initial region)
-    else if (phi <= 0) arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
+    if (d <= 0) {
+      arrival = time;  // already burnt at t^n (the initial region)
+    } else if (phi <= 0) {
+      arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
+      if (speed) rate_.heights[std::size_t(&arrival - grid_.heights.data())] = rate;
+    }
   };
   if (!swept_ || changed.empty()) {
     PlanLocator locator(mesh, 2 * edge_length_stats(mesh).mean);
@@ -181,14 +194,6 @@ ScalarField ArrivalRaster::sample_at_vertices(const SurfaceMesh& mesh) const {
   ScalarField values(mesh.n_vertices(), std::numeric_limits<double>::quiet_NaN());
   for (auto v : mesh.vertices()) values[v.idx()] = raster_nearest(grid_, mesh.point(v)[0], mesh.point(v)[1]);
   return values;
-}
-
-void ArrivalRaster::write(const std::filesystem::path& file, const std::string& crs) const {
-  HeightGrid out = grid_;
-  out.crs = crs;
-  for (double& value : out.heights)
-    if (std::isnan(value)) value = out.nodata;
-  write_esri_ascii(file, out);
 }
 
 }  // namespace bodyfit::fire

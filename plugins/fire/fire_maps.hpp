@@ -30,7 +30,9 @@ struct WindField {
 /// is outside G at t^n (d > 0) and inside at t^n + Δt (φ^{n+1} ≤ 0) is reached at
 /// t^n + Δt·d/(d − φ^{n+1}), the zero of the linear interpolation in time of the level set.
 /// Cells never reached keep NODATA. The raster is the DEM's (when given) or covers the mesh's
-/// bounding box in plan view.
+/// bounding box in plan view. Beside it, the rate of spread at which each cell burnt: the normal
+/// speed of the step that reached it, interpolated at the cell centre (NaN for the cells of the
+/// initial region, which did not burn by spreading, and for cells never reached).
 class ArrivalRaster {
  public:
   bool initialised() const { return grid_.cols > 0; }
@@ -38,13 +40,14 @@ class ArrivalRaster {
   /// One (sub-)step: φ went from `distance` to `phi_next`, changing only at the vertices `changed`
   /// (all when empty). After the first update, which sweeps every cell (the initial region), only
   /// the cells under the faces around `changed` can be reached, and only those are visited.
+  /// `speed`: the rate of spread at the vertices of `mesh` in this step (null: not recorded).
   void update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next, double time, double dt,
-              std::span<const int> changed = {});
+              std::span<const int> changed = {}, const ScalarField* speed = nullptr);
   /// Arrival time at the vertices (bilinear over reached cells; NaN where none is reached yet).
   ScalarField sample_at_vertices(const SurfaceMesh& mesh) const;
-  /// As an ESRI ASCII grid, with a .prj beside it when `crs` (WKT) is known.
-  void write(const std::filesystem::path& file, const std::string& crs = {}) const;
+  /// Arrival times (s; NaN: not reached) and rates of spread (m/s; NaN: none) on the same raster.
   const HeightGrid& grid() const { return grid_; }
+  const HeightGrid& rate_grid() const { return rate_; }
   /// Into / back from a checkpoint's model state (keys "arrival.*"); load leaves the raster
   /// uninitialised when the state has none.
   void save(ModelState& state) const;
@@ -52,6 +55,7 @@ class ArrivalRaster {
 
  private:
   HeightGrid grid_;  ///< heights hold the arrival times (NaN = not reached)
+  HeightGrid rate_;  ///< the same frame; heights hold the rates of spread
   bool swept_ = false;  ///< every cell visited once (the initial region is in the raster)
   std::vector<std::uint32_t> face_seen_;  ///< = epoch_ for the faces visited by this update
   std::uint32_t epoch_ = 0;

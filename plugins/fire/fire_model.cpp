@@ -4,9 +4,14 @@
 #include "balbi.hpp"
 #include "fire_maps.hpp"
 
+#include <bodyfit/clock_time.hpp>
+#include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/parameters.hpp>
+#include <bodyfit/plan_geometry.hpp>
+#include <bodyfit/raster_io.hpp>
+#include <bodyfit/vector_io.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <fmt/format.h>
@@ -15,11 +20,74 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 namespace bodyfit::fire {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
+
+/// The burnt region of one state seen from above (a feature of the perimeter layer).
+struct Perimeter {
+  int iteration = 0;
+  double time = 0;
+  double surface_area = 0;  ///< |G| on the terrain, m²
+  std::vector<PlanPolygon> polygons;
+};
+
+// Perimeters in a checkpoint: per perimeter (iteration, polygon count), per polygon its ring
+// count, per ring its point count, then every point's x and y.
+void save_perimeters(const std::vector<Perimeter>& perimeters, ModelState& state) {
+  std::vector<std::int64_t> shape;
+  std::vector<double> numbers;
+  for (const auto& p : perimeters) {
+    shape.push_back(p.iteration);
+    shape.push_back(std::int64_t(p.polygons.size()));
+    numbers.push_back(p.time);
+    numbers.push_back(p.surface_area);
+    for (const auto& polygon : p.polygons) {
+      shape.push_back(std::int64_t(polygon.rings.size()));
+      for (const auto& ring : polygon.rings) {
+        shape.push_back(std::int64_t(ring.size()));
+        for (const auto& point : ring) numbers.insert(numbers.end(), point.begin(), point.end());
+      }
+    }
+  }
+  state.set("perimeters.shape", std::move(shape));
+  state.set("perimeters.numbers", std::move(numbers));
+}
+
+std::vector<Perimeter> load_perimeters(const ModelState& state) {
+  std::vector<Perimeter> perimeters;
+  if (!state.has("perimeters.shape")) return perimeters;
+  const auto& shape = state.integers("perimeters.shape");
+  const auto& numbers = state.numbers("perimeters.numbers");
+  std::size_t s = 0, n = 0;
+  auto count = [&] {
+    if (s >= shape.size() || shape[s] < 0) throw InputError("fire model state: the perimeters are inconsistent");
+    return std::size_t(shape[s++]);
+  };
+  auto number = [&] {
+    if (n >= numbers.size()) throw InputError("fire model state: the perimeters are inconsistent");
+    return numbers[n++];
+  };
+  while (s < shape.size()) {
+    Perimeter p;
+    p.iteration = int(count());
+    p.polygons.resize(count());
+    p.time = number();
+    p.surface_area = number();
+    for (auto& polygon : p.polygons) {
+      polygon.rings.resize(count());
+      for (auto& ring : polygon.rings) {
+        ring.resize(count());
+        for (auto& point : ring) point = {number(), number()};
+      }
+    }
+    perimeters.push_back(std::move(p));
+  }
+  return perimeters;
+}
 
 class FireModel final : public VelocityModel {
  public:
@@ -47,6 +115,11 @@ class FireModel final : public VelocityModel {
         {"fuel.presets", "[preset]", "parameter sets of the codes of fuel.map"},
         {"arrival.cell_size", "(mean edge length)", "cell size of the arrival-time raster, m"},
         {"arrival.like", "", "an ESRI ASCII grid (e.g. the DEM) whose raster the arrival times use"},
+        {"arrival.format", "\"tif\"", "tif (GeoTIFF with CRS, NODATA, units) | asc (ESRI ASCII grid + .prj): "
+                                      "arrival_time.<format> (s) and rate_of_spread.<format> (m/s)"},
+        {"perimeters.file", "\"perimeters.gpkg\"", "the burnt region's outline at every perimeters.every-th state "
+                                                   "and the last (.gpkg or .geojson; \"\": none)"},
+        {"perimeters.every", "1", "a perimeter every this many iterations"},
     };
   }
 
@@ -118,7 +191,14 @@ class FireModel final : public VelocityModel {
       const std::filesystem::path like = a.path("like");
       arrival_like_file_ = like;
       if (!like.empty()) arrival_like_ = read_dem(like);
+      arrival_format_ = a.choice("format", arrival_format_, {"tif", "asc"});
       a.reject_unknown();
+    }
+    if (const toml::table* perimeters = p.table("perimeters")) {
+      Parameters q(*perimeters, "model.perimeters");
+      perimeter_file_ = q.string("file", perimeter_file_);
+      perimeter_every_ = int(q.integer("every", perimeter_every_, 1));
+      q.reject_unknown();
     }
     // The rasters of one case share one coordinate system, which the outputs then carry.
     std::vector<std::pair<const HeightGrid*, std::filesystem::path>> rasters;
@@ -168,10 +248,14 @@ class FireModel final : public VelocityModel {
     };
     // A sub-step in a narrow band needs R at the band's vertices only, and no metrics or fields.
     if (const std::span<const int> active = context.active_vertices(); !active.empty()) {
-      for (int v : active) speed[v] = rate_at(v);
+      if (rates_.size() != mesh.n_vertices()) rates_.assign(mesh.n_vertices(), 0.0);
+      for (int v : active) speed[v] = rates_[std::size_t(v)] = rate_at(v);
       return VelocityField::normal(std::move(speed));
     }
     for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
+    rates_ = speed;  // the state's own compute: the rates the arrival raster records in its steps
+    clock_start_ = context.clock_start();
+    if (context.is_terrain()) record_perimeter(context);
 
     VelocityField field = VelocityField::normal(speed);
     // Rate of spread on the front: vertices of interface edges.
@@ -203,8 +287,11 @@ class FireModel final : public VelocityModel {
   }
 
   void end_step(const StepOutcome& outcome) override {
+    // dt = 0: a region joined G (a late ignition) on the accepted state, whose rates are not
+    // rates_ (those of the state before): its cells arrive at that time with no rate of spread.
     if (arrival_.initialised())
-      arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt, outcome.changed);
+      arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt, outcome.changed,
+                      outcome.dt > 0 && rates_.size() == outcome.mesh.n_vertices() ? &rates_ : nullptr);
   }
 
   // What a resumed run needs to continue exactly: the arrival times so far and the rotating wind's
@@ -212,6 +299,7 @@ class FireModel final : public VelocityModel {
   void save_state(ModelState& state) const override {
     state.version = 1;
     arrival_.save(state);
+    save_perimeters(perimeters_, state);
     if (wind_.has_center) state.set("wind.center", std::vector<double>{wind_.center[0], wind_.center[1], wind_.center[2]});
   }
 
@@ -219,6 +307,7 @@ class FireModel final : public VelocityModel {
     if (state.version != 1)
       throw InputError(fmt::format("fire model state version {} (this plugin reads version 1)", state.version));
     arrival_.load(state);
+    perimeters_ = load_perimeters(state);
     if (state.has("wind.center")) {
       const auto& c = state.numbers("wind.center");
       if (c.size() != 3) throw InputError("fire model state: wind.center needs 3 numbers");
@@ -228,10 +317,72 @@ class FireModel final : public VelocityModel {
   }
 
   void finish(const std::filesystem::path& output_dir) override {
-    if (arrival_.initialised() && !output_dir.empty()) arrival_.write(output_dir / "arrival_time.asc", crs_);
+    if (output_dir.empty()) return;
+    if (arrival_.initialised()) {
+      const std::string since = clock_start_ ? "after " + format_iso8601(*clock_start_) : "after the start (t = 0)";
+      std::vector<std::pair<std::string, std::string>> items;
+      if (clock_start_) items.emplace_back("START_TIME", format_iso8601(*clock_start_));
+      HeightGrid arrival = arrival_.grid();
+      arrival.crs = crs_;
+      write_raster(output_dir / ("arrival_time." + arrival_format_), arrival,
+                   {.units = "s", .description = "fire arrival time, seconds " + since, .items = items});
+      HeightGrid rate = arrival_.rate_grid();
+      rate.crs = crs_;
+      write_raster(output_dir / ("rate_of_spread." + arrival_format_), rate,
+                   {.units = "m/s",
+                    .description = "rate of spread (Balbi) at which the cell burnt, m/s (NODATA: not reached, or "
+                                   "burning at the start)",
+                    .items = items});
+    }
+    write_perimeters(output_dir);
   }
 
  private:
+  // The state's outline, once per iteration (sub-steps and retried steps compute on the same
+  // state); kept when it is a perimeters.every-th state, and always as the latest (the final state
+  // is the last one computed: finish() adds it).
+  void record_perimeter(const StepContext& context) {
+    if (perimeter_file_.empty()) return;
+    const int iteration = context.iteration();
+    if (!perimeters_.empty() && perimeters_.back().iteration >= iteration) return;
+    if (latest_ && latest_->iteration == iteration) return;
+    Perimeter p{.iteration = iteration,
+                .time = context.time(),
+                .surface_area = region_area(context.mesh(), kInside),
+                .polygons = region_outline(context.mesh(), kInside)};
+    if (iteration % perimeter_every_ == 0) {
+      perimeters_.push_back(std::move(p));
+      latest_.reset();
+      write_perimeters(context.output_dir());
+    } else {
+      latest_ = std::move(p);
+    }
+  }
+
+  // The perimeter layer as it stands (rewritten whole, atomically: a killed run leaves the
+  // previous one).
+  void write_perimeters(const std::filesystem::path& output_dir) const {
+    if (perimeter_file_.empty() || output_dir.empty() || (perimeters_.empty() && !latest_)) return;
+    VectorLayer layer;
+    layer.name = "perimeters";
+    layer.crs = crs_;
+    auto add = [&](const Perimeter& p) {
+      VectorFeature f;
+      f.geometry.polygons = p.polygons;
+      double area = 0, length = 0;
+      for (const auto& polygon : p.polygons) area += polygon_area(polygon), length += polygon_perimeter(polygon);
+      f.attributes = {{"iteration", std::int64_t(p.iteration)}, {"time", p.time}};
+      if (clock_start_) f.attributes.emplace_back("datetime", format_iso8601(*clock_start_ + p.time));
+      f.attributes.emplace_back("area", area);
+      f.attributes.emplace_back("perimeter", length);
+      f.attributes.emplace_back("surface_area", p.surface_area);
+      layer.features.push_back(std::move(f));
+    };
+    for (const auto& p : perimeters_) add(p);
+    if (latest_) add(*latest_);
+    write_polygon_layer(output_dir / perimeter_file_, layer);
+  }
+
   // Fuel at a point: the uniform fuel, or the map's code (0 = not burnable → null).
   const BalbiParameters* fuel_at(const Vec3& x) const {
     if (fuel_map_.cols == 0) return fuels_.empty() ? &base_ : &fuels_.front();
@@ -249,6 +400,13 @@ class FireModel final : public VelocityModel {
   std::string crs_;
   std::filesystem::path fuel_file_, wind_u_file_, wind_v_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
+  ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
+  std::string arrival_format_ = config::have_gdal ? "tif" : "asc";
+  std::string perimeter_file_ = config::have_gdal ? "perimeters.gpkg" : "";
+  int perimeter_every_ = 1;
+  std::vector<Perimeter> perimeters_;
+  std::optional<Perimeter> latest_;  ///< the latest state's, when not a perimeters.every-th
+  std::optional<double> clock_start_;
 };
 
 }  // namespace

@@ -10,6 +10,11 @@ namespace bodyfit {
 /// check the stream and rename it over `target`. On any failure the temporary is removed and an
 /// InputError naming `target` is thrown; `target` is never left half-written.
 void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write);
+/// The same for a writer that opens the file itself (GDAL): `write` creates the temporary at the
+/// path it is given and throws on failure; the temporary is then renamed over `target`, or removed
+/// when `write` throws.
+void write_atomically_at(const std::filesystem::path& target,
+                         const std::function<void(const std::filesystem::path& temporary)>& write);
 
 /// Whether a file name is one of write_atomically's temporaries (".<target>.tmp<pid>-<n>"): one
 /// that exists when no write is in progress was left by a process killed during the write.

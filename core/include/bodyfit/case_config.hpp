@@ -6,8 +6,10 @@
 //   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
 //                degrees, center; or axes = [[..], ..] and angles = [..] for a union of caps) | "disks" (centers = [[x, y], ...], radii = [...])
 //                | "balls" (centers = [[x, y, z], ...], radii = [...]: S inside the balls)
+//                | "ignitions" (file = a vector layer of points, lines, polygons; radius; time_attribute)
 //   [model]      name = "conormal", every other key is the model's own parameter
-//   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, narrow_band, max_substeps, max_rejections
+//   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, narrow_band, max_substeps,
+//                max_rejections; start = "2026-07-14T13:00:00Z" (the clock time of t = 0)
 //   [distance] [advection] [discretize] [remesh]   options of each stage
 //   [output]     vtu_every, png_every, field, view, size = [w, h], checkpoint_every, checkpoint_seconds
 //
@@ -32,6 +34,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,7 +51,7 @@ struct SurfaceSpec {
 };
 
 struct RegionSpec {
-  enum class Kind { Refs, Sol, Cap, Disks, Balls };
+  enum class Kind { Refs, Sol, Cap, Disks, Balls, Ignitions };
   Kind kind = Kind::Cap;
   std::vector<int> refs{kInside};   ///< Kind::Refs: face refs of the file that make up G
   std::filesystem::path sol;        ///< Kind::Sol: φ at the vertices of the surface (< 0 inside)
@@ -59,6 +62,14 @@ struct RegionSpec {
   Vec3 center{0, 0, 0};             ///< Kind::Cap: centre of the sphere
   std::vector<std::array<double, 3>> disks;  ///< Kind::Disks: (x, y, radius), horizontal distance
   std::vector<std::array<double, 4>> balls;  ///< Kind::Balls: (x, y, z, radius), the part of S in the balls
+  /// Kind::Ignitions: a vector layer (GeoJSON, Shapefile, GeoPackage…) of points (disks of
+  /// `ignition_radius`), lines (buffers of that half-width) and polygons, in plan view; each
+  /// feature ignites at its `time_attribute` (seconds after t = 0, or an ISO 8601 date-time with
+  /// [time] start; absent or null: at t = 0). Later ignitions join G when their time comes
+  /// (EvolutionOptions::additions).
+  std::filesystem::path ignitions;
+  double ignition_radius = 0;
+  std::string time_attribute;
 };
 
 struct TimeSpec {
@@ -72,6 +83,9 @@ struct TimeSpec {
   /// A step the velocity model rejects is retried with half the time step at most this many times
   /// before the run stops (0: stop at the first rejection).
   int max_rejections = 5;
+  /// The date-time of t = 0 (ISO 8601 with its zone, as given) and its seconds since the epoch.
+  std::string start;
+  std::optional<double> start_seconds;
 };
 
 struct OutputSpec {

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,6 +69,16 @@ struct StateView {
   bool final;                      ///< the last state of the run
 };
 
+/// A region that joins G at a given time (a late ignition). The step that would pass `time` is
+/// shortened to end on it; the accepted state at `time` then has φ = min(d, level_set) cut into
+/// it and remeshed, before its outputs and checkpoint; the model sees the change as one more
+/// end_step with dt = 0 (φ from d to that minimum, on the state before the cut). A region whose
+/// time is not after the run's start is taken to be in it already (G(0) or a resumed state).
+struct ScheduledRegion {
+  double time = 0;
+  std::function<double(const Vec3&)> level_set;  ///< negative inside the region
+};
+
 /// How to evolve: what a case file sets.
 struct EvolutionOptions {
   double dt = 0;                 ///< time step (required, > 0); the last step is shortened to hit final_time
@@ -107,6 +118,10 @@ struct EvolutionOptions {
   RemeshOptions remesh;          ///< set `reference` so that S never drifts
   std::filesystem::path output_dir;  ///< handed to the model (StepContext::output_dir, finish)
   bool terrain = false;          ///< S is a height field (StepContext::is_terrain)
+  /// Seconds since 1970-01-01T00:00:00Z at t = 0 ([time] start; StepContext::clock_start).
+  std::optional<double> clock_start;
+  /// Regions joining G during the run, in any order (ScheduledRegion).
+  std::vector<ScheduledRegion> additions;
   /// Bring T^{n+1} to the form a checkpoint reads back (canonicalize) after each iteration, so a
   /// run resumed from a checkpoint continues exactly like the uninterrupted one.
   bool canonical_order = true;

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -33,7 +34,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 1;
+inline constexpr std::uint32_t kPluginAbiMinor = 2;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// One parameter a model accepts, for `bodyfit plugins` and for error messages.
@@ -77,6 +78,7 @@ struct StandaloneStep {
   int iteration = 0;
   std::filesystem::path output_dir;
   bool terrain = false;
+  std::optional<double> clock_start;  ///< StepContext::clock_start
 };
 
 /// Read-only view of the state at iteration n, with the helpers a model needs. Geometric helpers
@@ -109,6 +111,9 @@ class StepContext {
   /// least the band's width). conormal() is then filled only at these vertices. A model may
   /// compute everywhere anyway (correct, slower). Empty: every vertex (the state's own compute).
   std::span<const int> active_vertices() const;
+  /// The clock time of t = 0 in seconds since 1970-01-01T00:00:00Z, when the case gives one
+  /// ([time] start; ABI 2.2): t^n is then the date-time clock_start + t^n (clock_time.hpp formats it).
+  std::optional<double> clock_start() const;
 
   const std::vector<double>& face_areas() const;
   const VectorField& face_normals() const;
@@ -197,7 +202,9 @@ class VelocityModel {
   virtual ModelNeeds needs() const { return {}; }
   /// V^n on the current mesh.
   virtual VelocityField compute(const StepContext& context) = 0;
-  /// Called after each advection (each sub-step, each attempt), before the cut. Default: nothing.
+  /// Called after each advection (each sub-step, each attempt), before the cut; and once with
+  /// dt = 0 when a scheduled region joins G (EvolutionOptions::additions: φ goes from d to
+  /// min(d, ψ) on the accepted state, before that union is cut). Default: nothing.
   virtual void end_step(const StepOutcome&) {}
   /// The candidate T^{n+1} (cut and remeshed), as a context: its mesh, d_{G^{n+1}}, time t^n + Δt,
   /// iteration n + 1, dt() the step tried. `attempt` counts earlier rejections of this step.
