@@ -13,7 +13,7 @@
 
 namespace bodyfit::gis {
 
-inline constexpr std::uint32_t kApiVersion = 1;
+inline constexpr std::uint32_t kApiVersion = 2;
 
 /// What bodyfit needs to know of a coordinate system.
 struct CrsInfo {
@@ -34,6 +34,11 @@ struct Api {
   bool (*describe_crs)(const std::string& wkt, CrsInfo& info, std::string& error) = nullptr;
   /// Whether two WKT texts describe the same coordinate system.
   bool (*same_crs)(const std::string& a, const std::string& b) = nullptr;
+  /// `grid` (its coordinate system in grid.crs) warped to EPSG:`epsg` into `out` with GDAL's warper:
+  /// bilinear over valid cells, NODATA kept (cells outside the source too), square cells of
+  /// `cell_size` (0: GDAL's suggested size rounded to two significant figures) on a lattice aligned
+  /// with multiples of the cell size; out.crs is the target's WKT. False with `error` set on failure.
+  bool (*warp_raster)(const HeightGrid& grid, int epsg, double cell_size, HeightGrid& out, std::string& error) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built
