@@ -1,6 +1,7 @@
 // Generators: geodesic spheres (counts, quality, radius, topology), flat squares (counts, flatness,
 // boundary, quality), procedural terrains (boundary, topology, heights, reproducibility, edge
 // lengths), DEM rasters (.asc, GeoTIFF).
+#include <bodyfit/case_config.hpp>
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
@@ -584,6 +585,19 @@ TEST_CASE("dem: a GeoTIFF in degrees is refused, or reprojected to its UTM zone 
              "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],"
              "PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]");
   CHECK(read_dem(dir / "deg.asc", {.reproject = Reprojection::utm}).crs.find("UTM zone 32N") != std::string::npos);
+  // A case's [surface] reproject = "utm" takes it too: a terrain in metres over zone 32N's raster.
+  const std::string case_text = fmt::format(
+      "[surface]\ngenerator = \"terrain\"\ndem = '{}'\nh = 1000.0\nreproject = \"utm\"\n"
+      "[region]\nshape = \"disks\"\ncenters = [[290000.0, 5500000.0]]\nradii = [2000.0]\n"
+      "[model]\nname = \"fire\"\n[time]\ndt = 60.0\niterations = 1\n",
+      tif.string());
+  const SurfaceMesh surface = make_case_surface(parse_case(toml::parse(case_text)));
+  const BoundingBox box = bounding_box(surface);
+  CHECK(box.min[0] >= x0);
+  CHECK(box.max[0] <= x1);
+  CHECK(box.min[1] >= y0);
+  CHECK(box.max[1] <= y1);
+  CHECK(boundary_loops(surface).size() == 2);  // the outline and the NODATA block's hole
   const auto refused = bodyfit::test::run_bodyfit("mesh terrain --dem '" + tif.string() + "' -o '" +
                                                   (dir / "t.mesh").string() + "'");
   CHECK(refused.exit_code == 1);
