@@ -229,4 +229,7 @@ TEST_CASE("terrain over NODATA: bodyfit mesh terrain says how many cells it left
   const auto bad = test::run_bodyfit(fmt::format("mesh terrain --dem {} --nodata zero -o {}",
                                                  (dir / "l.asc").string(), (dir / "bad.mesh").string()));
   CHECK(bad.exit_code == 2);
+  // Without a DEM there is no NODATA: a usage error.
+  const auto no_dem = test::run_bodyfit(fmt::format("mesh terrain --nodata fill -o {}", (dir / "p.mesh").string()));
+  CHECK(no_dem.exit_code == 2);
 }

@@ -53,19 +53,21 @@ bodyfit::cli::Command setup_mesh(CLI::App& app) {
   ter->add_option("--feature-size", terrain->feature_size, "horizontal scale of the largest hills (procedural)")
       ->capture_default_str()
       ->check(bodyfit::cli::finite_above(0));
-  ter->add_option("--dem", *dem, "DEM raster: ESRI ASCII grid .asc or GeoTIFF .tif; heights by bilinear interpolation");
+  auto* dem_option = ter->add_option("--dem", *dem, "DEM raster: ESRI ASCII grid .asc or GeoTIFF .tif; heights by bilinear interpolation");
   auto nodata = std::make_shared<std::string>("hole");
   ter->add_option("--nodata", *nodata,
                   "with --dem: NODATA cells are holes (the surface covers the valid cells only, its boundary follows "
                   "the data) or are filled with the nearest valid height")
       ->capture_default_str()
-      ->check(CLI::IsMember({"hole", "fill"}));
+      ->check(CLI::IsMember({"hole", "fill"}))
+      ->needs(dem_option);
   auto reproject = std::make_shared<std::string>("none");
   ter->add_option("--reproject", *reproject,
                   "with --dem: a raster in degrees (geographic coordinate system) is refused (none) or warped to the "
                   "WGS 84 / UTM zone of its centre (utm; bilinear, NODATA kept)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"none", "utm"}));
+      ->check(CLI::IsMember({"none", "utm"}))
+      ->needs(dem_option);
   ter->add_option("-o,--output", *output, formats)->required();
 
   return {cmd, [=]() {
