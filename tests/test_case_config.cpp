@@ -159,6 +159,32 @@ TEST_CASE("wrong types and values are errors naming the key") {
   CHECK_MESSAGE(contains(e, "line 20: [remesh] hmax: expected a number, got a string"), e);
 }
 
+TEST_CASE("[surface] nodata and reproject: with a dem only, hole and none by default") {
+  // A procedural terrain has no NODATA and nothing to reproject.
+  std::string e = error_of(kValidCase, {"surface.nodata=\"fill\""});
+  CHECK_MESSAGE(contains(e, "nodata: does not apply to generator 'sphere'"), e);
+  toml::table table = toml::parse(kValidCase);
+  table.insert_or_assign("surface", toml::table{{"generator", "terrain"}, {"h", 100.0}, {"nodata", "fill"}});
+  e = "no error";
+  try {
+    parse_case(table);
+  } catch (const InputError& error) {
+    e = error.what();
+  }
+  CHECK_MESSAGE(contains(e, "nodata: does not apply to a procedural terrain (no 'dem')"), e);
+  // With a dem: the defaults, the alternatives, and a choice outside them.
+  table.insert_or_assign("surface", toml::table{{"generator", "terrain"}, {"dem", "d.asc"}});
+  CaseConfig c = parse_case(table);
+  CHECK(c.surface.nodata == NodataMode::hole);
+  CHECK(c.surface.reproject == Reprojection::none);
+  table.insert_or_assign("surface", toml::table{{"generator", "terrain"}, {"dem", "d.asc"}, {"nodata", "fill"}, {"reproject", "utm"}});
+  c = parse_case(table);
+  CHECK(c.surface.nodata == NodataMode::fill);
+  CHECK(c.surface.reproject == Reprojection::utm);
+  table.insert_or_assign("surface", toml::table{{"generator", "terrain"}, {"dem", "d.asc"}, {"nodata", "zero"}});
+  CHECK_THROWS_WITH_AS(parse_case(table), doctest::Contains("nodata"), InputError);
+}
+
 TEST_CASE("[time] max_rejections: an integer >= 0, default 5") {
   CHECK(parse(kValidCase).time.max_rejections == 5);
   CHECK(parse(kValidCase, {"time.max_rejections=2"}).time.max_rejections == 2);

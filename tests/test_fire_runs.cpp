@@ -4,14 +4,15 @@
 
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/config.hpp>
-#include <bodyfit/io.hpp>
-#include <bodyfit/plan_geometry.hpp>
-#include <bodyfit/vector_io.hpp>
+#include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
+#include <bodyfit/plan_geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
+#include <bodyfit/vector_io.hpp>
 
 #include "gis_module.hpp"
 #include "test_support.hpp"
@@ -80,7 +81,7 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   return run;
 }
 
-// An ESRI ASCII grid read as written (the DEM reader fills NODATA cells, which an arrival map must keep).
+// An ESRI ASCII grid read as written, NODATA values included.
 HeightGrid read_raw_grid(const std::filesystem::path& file) {
   std::ifstream in(file);
   HeightGrid g;
@@ -276,6 +277,50 @@ TEST_CASE("a fuel map's non-burnable cells stop the front") {
   CHECK(650 + free_run > 800);                     // the barrier is really in the way
   CHECK(x_max <= 700 + 2 * h);                     // stopped within one cell of P1 interpolation of the speed
   CHECK(std::abs((500 - r0 - x_min) - free_run) / free_run < 0.02);  // the other side burns at R0
+}
+
+TEST_CASE("fuel NODATA and the codes of fuel.non_burnable stop the front; an unknown code is an error") {
+  test::TempDir dir("fire_fuel_nodata");
+  // 100 m cells over [0, 1200]²: NODATA (255, a byte raster's usual marker) for x ≥ 800, code 9
+  // (water, listed in non_burnable) for x < 400, fuel 1 between.
+  auto write_map = [&](const std::string& name, int unknown_code) {
+    std::ofstream out(dir / name);
+    out << "ncols 12\nnrows 12\nxllcorner 0\nyllcorner 0\ncellsize 100\nNODATA_value 255\n";
+    for (int r = 0; r < 12; ++r)
+      for (int c = 0; c < 12; ++c) out << (r == 5 && c == 6 ? unknown_code : c >= 8 ? 255 : c < 4 ? 9 : 1) << (c < 11 ? " " : "\n");
+  };
+  write_map("fuel.asc", 1);
+  const double R0 = fire::BalbiParameters{}.R0, h = 20, dt = 20, r0 = 150;
+  const int steps = 30;  // 600 s: unobstructed, the front would reach x = 750 + 600·R0 ≈ 989 m and 450 − 239 ≈ 211 m
+  const std::string model = fmt::format("[fuel]\nmap = \"{}\"\npresets = [\"balbi2009\"]\nnon_burnable = [9]\n",
+                                        (dir / "fuel.asc").string());
+  FireRun run = burn(inclined_plane(1200, h, 0), {{600, 600, r0}}, model, dt, steps, {}, 0.05);
+  REQUIRE(run.result.records.size() == std::size_t(steps));
+  const double free_run = R0 * run.result.time;
+  CHECK(750 + free_run > 800 + 2 * h);  // both blocks are really in the way
+  CHECK(450 - free_run < 400 - 2 * h);
+  // Burnt area in each block beyond the reach of the P1 interpolation of the speed (two edges).
+  double in_nodata = 0, in_water = 0, y_max = -1e30;
+  for (auto f : run.mesh.faces()) {
+    if (run.mesh.region(f) != kInside) continue;
+    const auto p = face_points(run.mesh, f);
+    const double x = (p[0][0] + p[1][0] + p[2][0]) / 3;
+    if (x > 800 + 2 * h) in_nodata += face_area(run.mesh, f);
+    if (x < 400 - 2 * h) in_water += face_area(run.mesh, f);
+    for (const auto& q : p) y_max = std::max(y_max, q[1]);
+  }
+  CHECK(in_nodata == 0);
+  CHECK(in_water == 0);
+  // Along the burnable strip the front runs at R0.
+  CHECK(std::abs((y_max - 750) - free_run) / free_run < 0.02);
+
+  // A code that is neither a preset's number, 0, NODATA nor listed: an error naming its cell.
+  write_map("unknown.asc", 7);
+  LoadedModel plugin = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
+  const std::string unknown = fmt::format("[fuel]\nmap = \"{}\"\npresets = [\"balbi2009\"]\nnon_burnable = [9]\n",
+                                          (dir / "unknown.asc").string());
+  CHECK_THROWS_WITH_AS(configure_model(plugin, toml::parse(unknown)), doctest::Contains("row 6, column 7"), InputError);
+  CHECK_THROWS_AS(configure_model(plugin, toml::parse("[fuel]\nnon_burnable = [1.5]\n")), InputError);
 }
 
 TEST_CASE("the fire cases of meshes/cases are valid and configure the plugin") {

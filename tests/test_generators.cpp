@@ -1,6 +1,7 @@
 // Generators: geodesic spheres (counts, quality, radius, topology), flat squares (counts, flatness,
 // boundary, quality), procedural terrains (boundary, topology, heights, reproducibility, edge
 // lengths), DEM rasters (.asc, GeoTIFF).
+#include <bodyfit/case_config.hpp>
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
@@ -308,18 +309,35 @@ TEST_CASE("dem: header variants: centre registration, any case, optional NODATA"
   CHECK(g.sample(10, 20) == 3);
 }
 
-TEST_CASE("dem: NODATA cells take the nearest valid height; all-NODATA is an error") {
+TEST_CASE("dem: NODATA cells are read as they are; fill_nodata gives them the nearest valid height; all-NODATA is an error") {
   bodyfit::test::TempDir dir("dem_nodata");
   write_text(dir / "n.asc",
              "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n"
              "5 5 -9999 7\n5 5 6 -9999\n-9999 -9999 -9999 8\n");
   auto g = read_esri_ascii(dir / "n.asc");
-  for (double v : g.heights) CHECK(v != -9999);
+  CHECK(count_nodata(g) == 5);
+  CHECK(!g.valid(0, 2));
+  CHECK(g.valid(0, 3));
+  CHECK(g.at(0, 2) == -9999);
+  // Bilinear sampling over the valid cells only: between the centres of (1, 1) = 5 and (1, 2) = 6
+  // with NODATA (2, 1), (2, 2) below, the weights of the valid row are renormalised.
+  CHECK(g.sample(1.5 + 0.25, 1.0 + 0.25) == doctest::Approx(5.25).epsilon(1e-14));
+  // Four NODATA cells around the point: no value.
+  HeightGrid corner;
+  corner.cols = corner.rows = 3;
+  corner.heights.assign(9, corner.nodata);
+  corner.heights[0] = 1;  // the north-west cell only
+  CHECK(corner.sample(0.5, 2.5) == 1);
+  CHECK(std::isnan(corner.sample(2.5, 0.5)));
+
+  HeightGrid filled = g;
+  CHECK(fill_nodata(filled) == 5);
+  CHECK(count_nodata(filled) == 0);
   // Each filled cell takes the value of a valid cell among its direct neighbours.
-  CHECK((g.at(0, 2) == 5 || g.at(0, 2) == 6 || g.at(0, 2) == 7));
+  CHECK((filled.at(0, 2) == 5 || filled.at(0, 2) == 6 || filled.at(0, 2) == 7));
   // (1, 3) touches 7, 6 and 8; the breadth-first fill takes a direct neighbour's value.
-  CHECK((g.at(1, 3) == 7 || g.at(1, 3) == 6 || g.at(1, 3) == 8));
-  CHECK((g.at(2, 0) == 5));
+  CHECK((filled.at(1, 3) == 7 || filled.at(1, 3) == 6 || filled.at(1, 3) == 8));
+  CHECK((filled.at(2, 0) == 5));
   write_text(dir / "all.asc", "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -1\n-1 -1\n");
   CHECK(error_of(dir / "all.asc").find("NODATA") != std::string::npos);
 }
@@ -415,7 +433,7 @@ TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone
 TEST_CASE("dem: a GeoTIFF made by gdal_translate reads as the .asc it came from") {
   bodyfit::test::TempDir dir("dem_tif");
   auto g = plane_grid();
-  g.heights[0] = g.nodata;  // filled the same way from both files
+  g.heights[0] = g.nodata;  // NODATA in both files
   g.heights[9] = 0.1;       // not a float: the .asc is read and the .tif written as Float64
   write_esri_ascii(dir / "g.asc", g);
   const auto tif = dir / "g.tif";
@@ -464,4 +482,129 @@ TEST_CASE("dem: terrain over the raster's extent, heights bilinear") {
   CHECK(edge_length_stats(mesh).mean == doctest::Approx(30).epsilon(0.15));
   auto finer = make_terrain_from_grid(g, 10);
   CHECK(finer.n_faces() > 5 * mesh.n_faces());
+}
+
+namespace {
+
+/// WGS 84 / UTM zone `zone` north coordinates of (lon, lat) in degrees: the Transverse Mercator
+/// series of Snyder, "Map Projections — A Working Manual" (1987), eqs. 8-9 to 8-10 (sub-metre
+/// within a zone).
+std::pair<double, double> utm_north(int zone, double lon_degrees, double lat_degrees) {
+  const double a = 6378137, f = 1 / 298.257223563, e2 = f * (2 - f), ep2 = e2 / (1 - e2), k0 = 0.9996;
+  const double phi = lat_degrees * M_PI / 180, dlambda = (lon_degrees - (6 * zone - 183)) * M_PI / 180;
+  const double n = a / std::sqrt(1 - e2 * std::sin(phi) * std::sin(phi));
+  const double t = std::tan(phi) * std::tan(phi), c = ep2 * std::cos(phi) * std::cos(phi), A = dlambda * std::cos(phi);
+  const double e4 = e2 * e2, e6 = e4 * e2;
+  const double m = a * ((1 - e2 / 4 - 3 * e4 / 64 - 5 * e6 / 256) * phi -
+                        (3 * e2 / 8 + 3 * e4 / 32 + 45 * e6 / 1024) * std::sin(2 * phi) +
+                        (15 * e4 / 256 + 45 * e6 / 1024) * std::sin(4 * phi) - (35 * e6 / 3072) * std::sin(6 * phi));
+  const double x = k0 * n * (A + (1 - t + c) * std::pow(A, 3) / 6 +
+                             (5 - 18 * t + t * t + 72 * c - 58 * ep2) * std::pow(A, 5) / 120);
+  const double y = k0 * (m + n * std::tan(phi) *
+                                 (A * A / 2 + (5 - t + 9 * c + 4 * c * c) * std::pow(A, 4) / 24 +
+                                  (61 - 58 * t + t * t + 600 * c - 330 * ep2) * std::pow(A, 6) / 720));
+  return {500000 + x, y};
+}
+
+}  // namespace
+
+TEST_CASE("dem: a GeoTIFF in degrees is refused, or reprojected to its UTM zone on request") {
+  bodyfit::test::TempDir dir("dem_reproject");
+  // 30 × 20 cells of 0.01° from (6.0° E, 49.5° N), height 300, a 6 × 6 block of NODATA in the middle.
+  HeightGrid g;
+  g.cols = 30, g.rows = 20, g.x_origin = 6.0, g.y_origin = 49.5, g.cell_size = 0.01;
+  for (std::size_t r = 0; r < g.rows; ++r)
+    for (std::size_t c = 0; c < g.cols; ++c)
+      g.heights.push_back(c >= 12 && c < 18 && r >= 7 && r < 13 ? g.nodata : 300.0);
+  write_esri_ascii(dir / "deg.asc", g);
+  if (!config::have_gdal) return;
+  if (std::system("command -v gdal_translate > /dev/null 2>&1") != 0) {
+    MESSAGE("gdal_translate not found (Debian package gdal-bin): reprojection test skipped");
+    return;
+  }
+  const auto tif = dir / "deg.tif";
+  const std::string command = "gdal_translate -q -a_srs EPSG:4326 -of GTiff -ot Float64 '" + (dir / "deg.asc").string() +
+                              "' '" + tif.string() + "'";
+  REQUIRE(std::system(command.c_str()) == 0);
+  CHECK_THROWS_WITH_AS(read_dem(tif), doctest::Contains("geographic"), InputError);
+  CHECK_THROWS_WITH_AS(read_dem(tif), doctest::Contains("reproject = \"utm\""), InputError);
+
+  const HeightGrid utm = read_dem(tif, {.reproject = Reprojection::utm});
+  CHECK(utm.crs.find("UTM zone 32N") != std::string::npos);
+  CHECK(utm.crs.find("AUTHORITY[\"EPSG\",\"32632\"]") != std::string::npos);
+  // Cells: GDAL's suggestion, between the source cell's east-west (0.01° ≈ 721 m at 49.6° N) and
+  // north-south (≈ 1113 m) lengths, rounded to two significant figures.
+  const double cell = utm.cell_size;
+  CHECK(cell >= 700);
+  CHECK(cell <= 1120);
+  CHECK(std::fmod(cell, 10.0) == 0);
+  // Extent: the source's outline projected (Snyder's series, independent of GDAL) fits in the
+  // raster, which exceeds it by at most two cells on each side (GDAL's suggested extent ends on a
+  // whole number of its cells; bodyfit snaps the corners outward to multiples of the cell).
+  double west = 1e300, east = -1e300, south = 1e300, north = -1e300;
+  for (int i = 0; i <= 100; ++i) {
+    const double t = i / 100.0;
+    for (auto [lon, lat] : {std::pair{6.0 + 0.3 * t, 49.5}, std::pair{6.0 + 0.3 * t, 49.7}, std::pair{6.0, 49.5 + 0.2 * t},
+                            std::pair{6.3, 49.5 + 0.2 * t}}) {
+      const auto [x, y] = utm_north(32, lon, lat);
+      west = std::min(west, x), east = std::max(east, x), south = std::min(south, y), north = std::max(north, y);
+    }
+  }
+  const double x0 = utm.x_origin, x1 = x0 + double(utm.cols) * cell;
+  const double y0 = utm.y_origin, y1 = y0 + double(utm.rows) * cell;
+  INFO("raster [" << x0 << ", " << x1 << "] × [" << y0 << ", " << y1 << "], outline [" << west << ", " << east
+                  << "] × [" << south << ", " << north << "], cell " << cell);
+  CHECK(x0 <= west + 1);
+  CHECK(x1 >= east - 1);
+  CHECK(y0 <= south + 1);
+  CHECK(y1 >= north - 1);
+  CHECK(x0 >= west - 2 * cell);
+  CHECK(x1 <= east + 2 * cell);
+  CHECK(y0 >= south - 2 * cell);
+  CHECK(y1 <= north + 2 * cell);
+  // Values: 300 wherever there is data (bilinear over valid cells of a constant); NODATA over the
+  // block's centre (6.15° E, 49.6° N) and outside the source, data at a point far from both.
+  std::size_t nodata = 0;
+  for (std::size_t r = 0; r < utm.rows; ++r)
+    for (std::size_t c = 0; c < utm.cols; ++c)
+      if (utm.valid(r, c)) CHECK(utm.at(r, c) == doctest::Approx(300).epsilon(1e-12));
+      else ++nodata;
+  CHECK(nodata == count_nodata(utm));
+  auto cell_at = [&](double lon, double lat) {
+    const auto [x, y] = utm_north(32, lon, lat);
+    const std::size_t col = std::size_t((x - x0) / cell), south_row = std::size_t((y - y0) / cell);
+    return std::pair{utm.rows - 1 - south_row, col};
+  };
+  const std::pair<std::size_t, std::size_t> hole = cell_at(6.15, 49.6), data = cell_at(6.05, 49.65);
+  CHECK(!utm.valid(hole.first, hole.second));
+  CHECK(utm.valid(data.first, data.second));
+  CHECK(!utm.valid(0, 0));  // the north-west corner: outside the (rotated) source
+
+  // The .asc with a geographic .prj beside it takes the same path; and the command says what it did.
+  write_text(dir / "deg.prj",
+             "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],"
+             "PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]");
+  CHECK(read_dem(dir / "deg.asc", {.reproject = Reprojection::utm}).crs.find("UTM zone 32N") != std::string::npos);
+  // A case's [surface] reproject = "utm" takes it too: a terrain in metres over zone 32N's raster.
+  const std::string case_text = fmt::format(
+      "[surface]\ngenerator = \"terrain\"\ndem = '{}'\nh = 1000.0\nreproject = \"utm\"\n"
+      "[region]\nshape = \"disks\"\ncenters = [[290000.0, 5500000.0]]\nradii = [2000.0]\n"
+      "[model]\nname = \"fire\"\n[time]\ndt = 60.0\niterations = 1\n",
+      tif.string());
+  const SurfaceMesh surface = make_case_surface(parse_case(toml::parse(case_text)));
+  const BoundingBox box = bounding_box(surface);
+  CHECK(box.min[0] >= x0);
+  CHECK(box.max[0] <= x1);
+  CHECK(box.min[1] >= y0);
+  CHECK(box.max[1] <= y1);
+  CHECK(boundary_loops(surface).size() == 2);  // the outline and the NODATA block's hole
+  const auto refused = bodyfit::test::run_bodyfit("mesh terrain --dem '" + tif.string() + "' -o '" +
+                                                  (dir / "t.mesh").string() + "'");
+  CHECK(refused.exit_code == 1);
+  const auto done = bodyfit::test::run_bodyfit("mesh terrain --dem '" + tif.string() + "' --reproject utm -o '" +
+                                               (dir / "t.mesh").string() + "'");
+  INFO(done.output);
+  CHECK(done.exit_code == 0);
+  CHECK(done.output.find(fmt::format("reprojected from WGS 84 to WGS 84 / UTM zone 32N, {} m cells", cell)) !=
+        std::string::npos);
 }

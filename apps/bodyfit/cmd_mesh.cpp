@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 
 namespace {
@@ -52,7 +53,21 @@ bodyfit::cli::Command setup_mesh(CLI::App& app) {
   ter->add_option("--feature-size", terrain->feature_size, "horizontal scale of the largest hills (procedural)")
       ->capture_default_str()
       ->check(bodyfit::cli::finite_above(0));
-  ter->add_option("--dem", *dem, "DEM raster: ESRI ASCII grid .asc or GeoTIFF .tif; heights by bilinear interpolation");
+  auto* dem_option = ter->add_option("--dem", *dem, "DEM raster: ESRI ASCII grid .asc or GeoTIFF .tif; heights by bilinear interpolation");
+  auto nodata = std::make_shared<std::string>("hole");
+  ter->add_option("--nodata", *nodata,
+                  "with --dem: NODATA cells are holes (the surface covers the valid cells only, its boundary follows "
+                  "the data) or are filled with the nearest valid height")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"hole", "fill"}))
+      ->needs(dem_option);
+  auto reproject = std::make_shared<std::string>("none");
+  ter->add_option("--reproject", *reproject,
+                  "with --dem: a raster in degrees (geographic coordinate system) is refused (none) or warped to the "
+                  "WGS 84 / UTM zone of its centre (utm; bilinear, NODATA kept)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "utm"}))
+      ->needs(dem_option);
   ter->add_option("-o,--output", *output, formats)->required();
 
   return {cmd, [=]() {
@@ -63,11 +78,18 @@ bodyfit::cli::Command setup_mesh(CLI::App& app) {
             } else if (ter->parsed()) {
               bodyfit::SurfaceMesh mesh;
               if (!dem->empty()) {
-                auto grid = bodyfit::read_dem(*dem);
-                spdlog::info("DEM {}: {} × {} cells of {} m, heights {:.6g}..{:.6g}", *dem, grid.cols, grid.rows,
-                             grid.cell_size, *std::min_element(grid.heights.begin(), grid.heights.end()),
-                             *std::max_element(grid.heights.begin(), grid.heights.end()));
-                mesh = bodyfit::make_terrain_from_grid(grid, h_option->count() ? terrain->h : 0.0);
+                const bodyfit::DemReadOptions read{
+                    .reproject = *reproject == "utm" ? bodyfit::Reprojection::utm : bodyfit::Reprojection::none};
+                auto grid = bodyfit::read_dem(*dem, read);
+                double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+                for (std::size_t r = 0; r < grid.rows; ++r)
+                  for (std::size_t c = 0; c < grid.cols; ++c)
+                    if (grid.valid(r, c)) lo = std::min(lo, grid.at(r, c)), hi = std::max(hi, grid.at(r, c));
+                spdlog::info("DEM {}: {} × {} cells of {} m, heights {:.6g}..{:.6g} ({} NODATA)", *dem, grid.cols,
+                             grid.rows, grid.cell_size, lo, hi, bodyfit::count_nodata(grid));
+                mesh = bodyfit::make_terrain_from_grid(
+                    grid, {.h = h_option->count() ? terrain->h : 0.0,
+                           .nodata = *nodata == "fill" ? bodyfit::NodataMode::fill : bodyfit::NodataMode::hole});
               } else {
                 mesh = bodyfit::make_terrain(*terrain);
               }

@@ -2,8 +2,12 @@
 #include "gis_module.hpp"
 #include "gdal_vector.hpp"
 
+#include <cpl_conv.h>
 #include <cpl_error.h>
+#include <cpl_string.h>
 #include <gdal.h>
+#include <gdal_alg.h>
+#include <gdalwarper.h>
 #include <ogr_srs_api.h>
 #include <fmt/format.h>
 
@@ -150,10 +154,140 @@ bool write_geotiff(const std::filesystem::path& file, const HeightGrid& grid, do
   return ok;
 }
 
-const Api kApi{.version = kApiVersion, .read_raster = read_raster, .describe_crs = describe_crs, .same_crs = same_crs,
-                  .write_geotiff = write_geotiff,
-                  .read_vector = read_vector,
-                  .write_polygons = write_polygons};
+/// A GDAL dataset, closed at the end of the scope.
+struct Dataset {
+  GDALDatasetH h = nullptr;
+  ~Dataset() {
+    if (h) GDALClose(h);
+  }
+};
+
+/// x rounded to two significant figures (a cell size of 187.3 m becomes 190 m).
+double two_significant(double x) {
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1);
+  return std::round(x / unit) * unit;
+}
+
+bool warp_raster(const HeightGrid& in, int epsg, double cell_size, HeightGrid& out, std::string& error) {
+  auto fail = [&](std::string what) {
+    error = fmt::format("{} (GDAL: {})", what, CPLGetLastErrorMsg());
+    return false;
+  };
+  GDALAllRegister();
+  GDALDriverH mem = GDALGetDriverByName("MEM");
+  if (!mem) return fail("GDAL has no in-memory driver");
+  // The source: the grid as it was read, NaN cells marked with the NODATA value.
+  Dataset source{GDALCreate(mem, "", int(in.cols), int(in.rows), 1, GDT_Float64, nullptr)};
+  if (!source.h) return fail("cannot create an in-memory raster");
+  double source_transform[6] = {in.x_origin, in.cell_size, 0, in.y_origin + double(in.rows) * in.cell_size, 0,
+                                -in.cell_size};
+  GDALSetGeoTransform(source.h, source_transform);
+  if (GDALSetProjection(source.h, in.crs.c_str()) != CE_None) return fail("cannot use the raster's coordinate system");
+  std::vector<double> values = in.heights;
+  for (double& value : values)
+    if (std::isnan(value)) value = in.nodata;
+  GDALRasterBandH source_band = GDALGetRasterBand(source.h, 1);
+  GDALSetRasterNoDataValue(source_band, in.nodata);
+  if (GDALRasterIO(source_band, GF_Write, 0, 0, int(in.cols), int(in.rows), values.data(), int(in.cols), int(in.rows),
+                   GDT_Float64, 0, 0) != CE_None)
+    return fail("cannot fill an in-memory raster");
+
+  Srs target;
+  if (OSRImportFromEPSG(target.h, epsg) != OGRERR_NONE) return fail(fmt::format("unknown EPSG code {}", epsg));
+  char* target_text = nullptr;
+  OSRExportToWkt(target.h, &target_text);
+  const std::string target_wkt = target_text ? target_text : "";
+  CPLFree(target_text);
+
+  // The target lattice: GDAL's suggested cell size rounded; the extent of the source's outline
+  // (sampled every 1/64 of each side: GDAL's suggested extent is rounded to whole cells, and may
+  // cut a corner off), its corners snapped outward to multiples of the cell.
+  void* suggest = GDALCreateGenImgProjTransformer(source.h, in.crs.c_str(), nullptr, target_wkt.c_str(), FALSE, 0, 1);
+  if (!suggest) return fail("no transformation between the coordinate systems");
+  double suggested[6];
+  int suggested_cols = 0, suggested_rows = 0;
+  const CPLErr suggested_ok =
+      GDALSuggestedWarpOutput(source.h, GDALGenImgProjTransform, suggest, suggested, &suggested_cols, &suggested_rows);
+  constexpr int kSamples = 64;
+  std::vector<double> xs, ys, zs;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double t = double(i) / kSamples, along_x = t * double(in.cols), along_y = t * double(in.rows);
+    for (auto [px, py] : {std::pair{along_x, 0.0}, std::pair{along_x, double(in.rows)}, std::pair{0.0, along_y},
+                          std::pair{double(in.cols), along_y}})
+      xs.push_back(px), ys.push_back(py);
+  }
+  zs.assign(xs.size(), 0.0);
+  std::vector<int> transformed(xs.size(), 0);
+  GDALGenImgProjTransform(suggest, FALSE, int(xs.size()), xs.data(), ys.data(), zs.data(), transformed.data());
+  GDALDestroyGenImgProjTransformer(suggest);
+  if (suggested_ok != CE_None) return fail("cannot find the raster's extent in the target system");
+  double west = HUGE_VAL, south = HUGE_VAL, east = -HUGE_VAL, north = -HUGE_VAL;
+  for (std::size_t i = 0; i < xs.size(); ++i)
+    if (transformed[i]) {
+      west = std::min(west, xs[i]), east = std::max(east, xs[i]);
+      south = std::min(south, ys[i]), north = std::max(north, ys[i]);
+    }
+  if (!(west < east && south < north)) return fail("cannot transform the raster's outline to the target system");
+  const double cell = cell_size > 0 ? cell_size : two_significant(suggested[1]);
+  out = HeightGrid{};
+  out.cell_size = cell;
+  out.x_origin = std::floor(west / cell) * cell;
+  out.y_origin = std::floor(south / cell) * cell;
+  out.cols = std::size_t(std::ceil((east - out.x_origin) / cell));
+  out.rows = std::size_t(std::ceil((north - out.y_origin) / cell));
+  out.nodata = in.nodata;
+  out.crs = target_wkt;
+  if (double(out.cols) * double(out.rows) > 4e8) return fail("the reprojected raster would be too large");
+
+  Dataset target_data{GDALCreate(mem, "", int(out.cols), int(out.rows), 1, GDT_Float64, nullptr)};
+  if (!target_data.h) return fail("cannot create an in-memory raster");
+  double target_transform[6] = {out.x_origin, cell, 0, out.y_origin + double(out.rows) * cell, 0, -cell};
+  GDALSetGeoTransform(target_data.h, target_transform);
+  GDALSetProjection(target_data.h, target_wkt.c_str());
+  GDALRasterBandH target_band = GDALGetRasterBand(target_data.h, 1);
+  GDALSetRasterNoDataValue(target_band, out.nodata);
+
+  GDALWarpOptions* options = GDALCreateWarpOptions();
+  options->hSrcDS = source.h;
+  options->hDstDS = target_data.h;
+  options->nBandCount = 1;
+  options->panSrcBands = static_cast<int*>(CPLMalloc(sizeof(int)));
+  options->panDstBands = static_cast<int*>(CPLMalloc(sizeof(int)));
+  options->panSrcBands[0] = options->panDstBands[0] = 1;
+  options->padfSrcNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
+  options->padfDstNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
+  options->padfSrcNoDataReal[0] = options->padfDstNoDataReal[0] = in.nodata;
+  options->eResampleAlg = GRA_Bilinear;
+  options->papszWarpOptions = CSLSetNameValue(options->papszWarpOptions, "INIT_DEST", "NO_DATA");
+  options->pTransformerArg =
+      GDALCreateGenImgProjTransformer(source.h, in.crs.c_str(), target_data.h, target_wkt.c_str(), FALSE, 0, 1);
+  options->pfnTransformer = GDALGenImgProjTransform;
+  bool warped = false;
+  if (options->pTransformerArg) {
+    GDALWarpOperationH operation = GDALCreateWarpOperation(options);
+    if (operation) {
+      warped = GDALChunkAndWarpImage(operation, 0, 0, int(out.cols), int(out.rows)) == CE_None;
+      GDALDestroyWarpOperation(operation);
+    }
+    GDALDestroyGenImgProjTransformer(options->pTransformerArg);
+  }
+  GDALDestroyWarpOptions(options);
+  if (!warped) return fail("the warp failed");
+  out.heights.resize(out.rows * out.cols);
+  if (GDALRasterIO(target_band, GF_Read, 0, 0, int(out.cols), int(out.rows), out.heights.data(), int(out.cols),
+                   int(out.rows), GDT_Float64, 0, 0) != CE_None)
+    return fail("cannot read the warped raster");
+  return true;
+}
+
+const Api kApi{.version = kApiVersion,
+               .read_raster = read_raster,
+               .describe_crs = describe_crs,
+               .same_crs = same_crs,
+               .write_geotiff = write_geotiff,
+               .read_vector = read_vector,
+               .write_polygons = write_polygons,
+               .warp_raster = warp_raster};
 
 }  // namespace
 }  // namespace bodyfit::gis

@@ -56,7 +56,7 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
   if (has_file) {
     out.kind = SurfaceSpec::Kind::File;
     out.file = resolve(base_dir, p.string("file", ""));
-    p.forbid({"faces", "radius", "h", "extent", "seed", "dem", "size", "max_height", "feature_size"},
+    p.forbid({"faces", "radius", "h", "extent", "seed", "dem", "nodata", "reproject", "size", "max_height", "feature_size"},
              "to a surface read from a file");
   } else {
     std::string g = p.choice("generator", "sphere", {"sphere", "terrain", "plane"});
@@ -72,7 +72,8 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
       check_face_budget(count, faces > 0 ? fmt::format("[surface] faces = {}", faces)
                                          : fmt::format("[surface] h = {} on a sphere of radius {}", h, out.sphere.radius));
       out.sphere.faces = std::size_t(std::llround(std::min(count, 1e18)));  // 1e18: only with --max-faces 0
-      p.forbid({"extent", "seed", "dem", "size", "max_height", "feature_size"}, "to generator 'sphere'");
+      p.forbid({"extent", "seed", "dem", "nodata", "reproject", "size", "max_height", "feature_size"},
+               "to generator 'sphere'");
     } else if (g == "terrain") {
       out.kind = SurfaceSpec::Kind::Terrain;
       out.terrain.extent = p.number("extent", out.terrain.extent, kPositive);
@@ -82,12 +83,19 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
       out.terrain.max_height = p.number("max_height", out.terrain.max_height);
       out.terrain.feature_size = p.number("feature_size", out.terrain.feature_size, kPositive);
       out.dem = resolve(base_dir, p.string("dem", ""));
+      if (out.dem.empty()) {
+        p.forbid({"nodata", "reproject"}, "to a procedural terrain (no 'dem')");
+      } else {
+        out.nodata = p.choice("nodata", "hole", {"hole", "fill"}) == "fill" ? NodataMode::fill : NodataMode::hole;
+        out.reproject = p.choice("reproject", "none", {"none", "utm"}) == "utm" ? Reprojection::utm : Reprojection::none;
+      }
       p.forbid({"faces", "radius", "size"}, "to generator 'terrain'");
     } else {
       out.kind = SurfaceSpec::Kind::Plane;
       out.plane.size = p.number("size", out.plane.size, kPositive);
       out.plane.h = p.number("h", out.plane.h, kPositive);
-      p.forbid({"faces", "radius", "extent", "seed", "dem", "max_height", "feature_size"}, "to generator 'plane'");
+      p.forbid({"faces", "radius", "extent", "seed", "dem", "nodata", "reproject", "max_height", "feature_size"},
+               "to generator 'plane'");
     }
   }
   p.reject_unknown();

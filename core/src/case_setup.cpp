@@ -101,7 +101,8 @@ SurfaceMesh make_case_surface(const CaseConfig& config) {
     case SurfaceSpec::Kind::Sphere:
       return make_sphere(s.sphere);
     case SurfaceSpec::Kind::Terrain:
-      return s.dem.empty() ? make_terrain(s.terrain) : make_terrain_from_grid(read_dem(s.dem), s.terrain.h);
+      if (s.dem.empty()) return make_terrain(s.terrain);
+      return make_terrain_from_grid(read_dem(s.dem, {.reproject = s.reproject}), {.h = s.terrain.h, .nodata = s.nodata});
     case SurfaceSpec::Kind::Plane:
       return make_plane(s.plane);
   }

@@ -1,7 +1,7 @@
 // Digital elevation models: ESRI ASCII grids (read/write) and GeoTIFF (read, through the GDAL module when
-// bodyfit was built with it), bilinear sampling. NODATA cells are filled with the value of the
-// nearest valid cell (breadth-first over the 8-neighbourhood) and a warning says how many; a raster
-// without any valid cell is an error.
+// bodyfit was built with it), bilinear sampling over the valid cells, the nearest-valid fill. NODATA
+// cells are read as they are (no terrain, no fuel: the users of the raster decide); a raster without
+// any valid cell is an error.
 #include <bodyfit/generators.hpp>
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
@@ -19,39 +19,19 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 namespace bodyfit {
 namespace {
 
 bool is_nodata(double value, double nodata) { return std::isnan(value) || value == nodata; }
 
-// Replace NODATA cells by their nearest valid cell (multi-source BFS, 8-neighbourhood).
-void fill_nodata(HeightGrid& grid, const std::filesystem::path& file) {
-  const std::size_t n = grid.heights.size();
-  std::vector<char> valid(n, 0);
-  std::vector<std::size_t> queue;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!is_nodata(grid.heights[i], grid.nodata)) valid[i] = 1, queue.push_back(i);
-  if (queue.size() == n) return;
-  if (queue.empty()) throw file_error(file, "every cell is NODATA");
-  const std::size_t missing = n - queue.size();
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const std::size_t r = queue[head] / grid.cols, c = queue[head] % grid.cols;
-    for (int dr = -1; dr <= 1; ++dr)
-      for (int dc = -1; dc <= 1; ++dc) {
-        const long rr = long(r) + dr, cc = long(c) + dc;
-        if (rr < 0 || cc < 0 || rr >= long(grid.rows) || cc >= long(grid.cols)) continue;
-        const std::size_t k = std::size_t(rr) * grid.cols + std::size_t(cc);
-        if (valid[k]) continue;
-        valid[k] = 1;
-        grid.heights[k] = grid.heights[queue[head]];
-        queue.push_back(k);
-      }
-  }
-  spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid height", file.string(), missing, n);
+void require_some_data(const HeightGrid& grid, const std::filesystem::path& file) {
+  if (count_nodata(grid) == grid.heights.size()) throw file_error(file, "every cell is NODATA");
 }
 
 // Heights beyond this are not terrain (the Earth's radius is 6.4e6 m; in feet, 2.1e7): a NODATA
@@ -61,7 +41,7 @@ constexpr double kMaxHeight = 1e8;
 
 void check_heights(const HeightGrid& grid, const std::filesystem::path& file) {
   for (std::size_t i = 0; i < grid.heights.size(); ++i)
-    if (!(std::abs(grid.heights[i]) <= kMaxHeight))
+    if (!is_nodata(grid.heights[i], grid.nodata) && !(std::abs(grid.heights[i]) <= kMaxHeight))
       throw file_error(file, fmt::format("the height {} of the cell at row {}, column {} is beyond ±{:.0e}: not a "
                                          "terrain height (a NODATA value the header does not declare?)",
                                          grid.heights[i], i / grid.cols + 1, i % grid.cols + 1, kMaxHeight));
@@ -84,6 +64,37 @@ std::optional<double> parse_number(const std::string& token) {
 
 }  // namespace
 
+bool HeightGrid::valid(std::size_t row, std::size_t col) const { return !is_nodata(at(row, col), nodata); }
+
+std::size_t count_nodata(const HeightGrid& grid) {
+  return std::size_t(std::count_if(grid.heights.begin(), grid.heights.end(),
+                                   [&](double value) { return is_nodata(value, grid.nodata); }));
+}
+
+std::size_t fill_nodata(HeightGrid& grid) {
+  const std::size_t n = grid.heights.size();
+  std::vector<char> valid(n, 0);
+  std::vector<std::size_t> queue;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!is_nodata(grid.heights[i], grid.nodata)) valid[i] = 1, queue.push_back(i);
+  if (queue.size() == n || queue.empty()) return 0;
+  const std::size_t missing = n - queue.size();
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::size_t r = queue[head] / grid.cols, c = queue[head] % grid.cols;
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        const long rr = long(r) + dr, cc = long(c) + dc;
+        if (rr < 0 || cc < 0 || rr >= long(grid.rows) || cc >= long(grid.cols)) continue;
+        const std::size_t k = std::size_t(rr) * grid.cols + std::size_t(cc);
+        if (valid[k]) continue;
+        valid[k] = 1;
+        grid.heights[k] = grid.heights[queue[head]];
+        queue.push_back(k);
+      }
+  }
+  return missing;
+}
+
 double HeightGrid::sample(double x, double y) const {
   // Continuous cell coordinates: cell centres at integers, u eastward, v northward from the south row.
   const double u = std::clamp((x - x_origin) / cell_size - 0.5, 0.0, double(cols - 1));
@@ -93,9 +104,28 @@ double HeightGrid::sample(double x, double y) const {
   const std::size_t c1 = std::min(c0 + 1, cols - 1), s1 = std::min(s0 + 1, rows - 1);
   const double fu = u - double(c0), fv = v - double(s0);
   auto south = [&](std::size_t s, std::size_t c) { return at(rows - 1 - s, c); };
-  const double lower_row = (1 - fu) * south(s0, c0) + fu * south(s0, c1);
-  const double upper_row = (1 - fu) * south(s1, c0) + fu * south(s1, c1);
-  return (1 - fv) * lower_row + fv * upper_row;
+  auto valid_south = [&](std::size_t s, std::size_t c) { return valid(rows - 1 - s, c); };
+  if (valid_south(s0, c0) && valid_south(s0, c1) && valid_south(s1, c0) && valid_south(s1, c1)) {
+    const double lower_row = (1 - fu) * south(s0, c0) + fu * south(s0, c1);
+    const double upper_row = (1 - fu) * south(s1, c0) + fu * south(s1, c1);
+    return (1 - fv) * lower_row + fv * upper_row;
+  }
+  // Next to NODATA: the valid corners only, their weights renormalised (or, when those weights are
+  // all zero, their plain mean).
+  const std::array<std::array<std::size_t, 2>, 4> corner{{{s0, c0}, {s0, c1}, {s1, c0}, {s1, c1}}};
+  const std::array<double, 4> weight{(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+  double sum = 0, weights = 0, plain_sum = 0;
+  int count = 0;
+  for (int k = 0; k < 4; ++k) {
+    const auto [s, c] = corner[std::size_t(k)];
+    if (!valid_south(s, c)) continue;
+    sum += weight[std::size_t(k)] * south(s, c);
+    weights += weight[std::size_t(k)];
+    plain_sum += south(s, c);
+    ++count;
+  }
+  if (weights > 0) return sum / weights;
+  return count ? plain_sum / count : std::numeric_limits<double>::quiet_NaN();
 }
 
 namespace {
@@ -118,17 +148,29 @@ std::string read_prj(const std::filesystem::path& file) {
   return text;
 }
 
+/// The WGS 84 / UTM zone of a raster's centre, its coordinates taken as degrees of longitude and latitude.
+struct UtmZone {
+  int zone = 0;
+  bool north = true;
+  int epsg() const { return (north ? 32600 : 32700) + zone; }
+};
+
+UtmZone utm_zone_of(const HeightGrid& grid) {
+  const double lon = grid.x_origin + 0.5 * grid.cell_size * double(grid.cols);
+  const double lat = grid.y_origin + 0.5 * grid.cell_size * double(grid.rows);
+  return {std::clamp(int(std::floor((lon + 180) / 6)) + 1, 1, 60), lat >= 0};
+}
+
 /// Degrees are not metres. A geographic raster is refused, with the UTM zone of its centre to
 /// project it to; a projected one in other units than metres too. Without a coordinate system,
 /// coordinates that look like degrees get a warning.
 void require_metres(const HeightGrid& grid, const std::filesystem::path& file) {
   const double west = grid.x_origin, south = grid.y_origin;
   const double east = west + grid.cell_size * double(grid.cols), north = south + grid.cell_size * double(grid.rows);
-  const double lon = 0.5 * (west + east), lat = 0.5 * (south + north);
-  const int zone = std::clamp(int(std::floor((lon + 180) / 6)) + 1, 1, 60);
+  const UtmZone zone = utm_zone_of(grid);
   const std::string projection =
-      fmt::format("gdalwarp -t_srs EPSG:{}{:02d} {} projected.tif` (WGS 84 / UTM zone {}{}, that of its centre)",
-                  lat >= 0 ? 326 : 327, zone, file.string(), zone, lat >= 0 ? 'N' : 'S');
+      fmt::format("gdalwarp -t_srs EPSG:{} {} projected.tif` (WGS 84 / UTM zone {}{}, that of its centre)", zone.epsg(),
+                  file.string(), zone.zone, zone.north ? 'N' : 'S');
   if (grid.crs.empty()) {
     if (grid.cell_size < 0.01 && west >= -180 && east <= 180 && south >= -90 && north <= 90)
       spdlog::warn("{}: no coordinate system (no .prj) and cells of {} m: if these are degrees, project the raster "
@@ -142,12 +184,34 @@ void require_metres(const HeightGrid& grid, const std::filesystem::path& file) {
   if (!gis.describe_crs(grid.crs, info, error)) throw file_error(file, error);
   if (info.geographic)
     throw file_error(file, fmt::format("its coordinate system '{}' is geographic (degrees of longitude and latitude), "
-                                       "and bodyfit works in metres: project the raster first, e.g. `{}",
+                                       "and bodyfit works in metres: project the raster first, e.g. `{}, or let "
+                                       "bodyfit do it ([surface] reproject = \"utm\", bodyfit mesh terrain "
+                                       "--reproject utm)",
                                        info.name, projection));
   if (std::abs(info.metres_per_unit - 1) > 1e-9)
     throw file_error(file, fmt::format("its coordinate system '{}' measures in units of {} m, and bodyfit works in "
                                        "metres: reproject it to a metric system (gdalwarp -t_srs)",
                                        info.name, info.metres_per_unit));
+}
+
+/// A geographic raster warped to the UTM zone of its centre (through the GDAL module), said in the
+/// log; any other raster is returned as it is.
+HeightGrid reproject_to_utm(HeightGrid grid, const std::filesystem::path& file) {
+  if (grid.crs.empty()) return grid;  // nothing to reproject from: require_metres warns if it looks like degrees
+  const gis::Api& gis = gis::module_for(file);
+  gis::CrsInfo from;
+  std::string error;
+  if (!gis.describe_crs(grid.crs, from, error)) throw file_error(file, error);
+  if (!from.geographic) return grid;
+  const UtmZone zone = utm_zone_of(grid);
+  HeightGrid warped;
+  if (!gis.warp_raster(grid, zone.epsg(), 0, warped, error))
+    throw file_error(file, fmt::format("cannot reproject it to EPSG:{}: {}", zone.epsg(), error));
+  gis::CrsInfo to;
+  if (!gis.describe_crs(warped.crs, to, error)) throw file_error(file, error);
+  spdlog::info("{}: reprojected from {} to {}, {} m cells ({} × {}, bilinear, NODATA kept)", file.string(), from.name,
+               to.name, warped.cell_size, warped.cols, warped.rows);
+  return warped;
 }
 
 }  // namespace
@@ -240,7 +304,7 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file) {
   if (grid.heights.size() < expected)
     throw file_error(file, line_no, fmt::format("truncated: expected {} values ({} rows × {} columns), found {}",
                                                 expected, grid.rows, grid.cols, grid.heights.size()));
-  fill_nodata(grid, file);
+  require_some_data(grid, file);
   check_heights(grid, file);
   grid.crs = read_prj(file);
   return grid;
@@ -271,17 +335,18 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
   HeightGrid grid;
   std::string error;
   if (!gis.read_raster(file, grid, error)) throw file_error(file, error);
-  fill_nodata(grid, file);
+  require_some_data(grid, file);
   check_heights(grid, file);
   return grid;
 }
 
-HeightGrid read_dem(const std::filesystem::path& file) {
+HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options) {
   const std::string ext = lower(file.extension().string());
   HeightGrid grid;
   if (ext == ".asc") grid = read_esri_ascii(file);
   else if (ext == ".tif" || ext == ".tiff") grid = read_geotiff(file);
   else throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file);
   require_metres(grid, file);
   return grid;
 }

@@ -15,7 +15,7 @@
 
 namespace bodyfit::gis {
 
-inline constexpr std::uint32_t kApiVersion = 2;
+inline constexpr std::uint32_t kApiVersion = 3;
 
 /// What bodyfit needs to know of a coordinate system.
 struct CrsInfo {
@@ -48,6 +48,11 @@ struct Api {
   /// false with `error` set on failure. (version 2)
   bool (*write_polygons)(const std::filesystem::path& file, const std::string& driver, const VectorLayer& layer,
                          std::string& error) = nullptr;
+  /// `grid` (its coordinate system in grid.crs) warped to EPSG:`epsg` into `out` with GDAL's warper:
+  /// bilinear over valid cells, NODATA kept (cells outside the source too), square cells of
+  /// `cell_size` (0: GDAL's suggested size rounded to two significant figures) on a lattice aligned
+  /// with multiples of the cell size; out.crs is the target's WKT. False with `error` set on failure. (version 3)
+  bool (*warp_raster)(const HeightGrid& grid, int epsg, double cell_size, HeightGrid& out, std::string& error) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built

@@ -15,6 +15,7 @@
 #include <bodyfit/velocity_model.hpp>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -111,8 +112,9 @@ class FireModel final : public VelocityModel {
         {"wind.center", "(domain centre)", "rotating wind centre (x, y), m: U = scale·(y − yc, −(x − xc), 0)"},
         {"wind.scale", "0.001", "rotating wind angular rate, 1/s (m/s of wind per m from the centre)"},
         {"wind.u_file, wind.v_file", "", "gridded wind components, ESRI ASCII grids (m/s)"},
-        {"fuel.map", "", "ESRI ASCII grid of fuel codes: 0 = not burnable, k ≥ 1 = fuel.presets[k−1]"},
+        {"fuel.map", "", "raster of fuel codes: k ≥ 1 = fuel.presets[k−1]; 0, NODATA and fuel.non_burnable do not burn"},
         {"fuel.presets", "[preset]", "parameter sets of the codes of fuel.map"},
+        {"fuel.non_burnable", "[]", "more codes of fuel.map that do not burn (water, rock, e.g. [98, 99])"},
         {"arrival.cell_size", "(mean edge length)", "cell size of the arrival-time raster, m"},
         {"arrival.like", "", "an ESRI ASCII grid (e.g. the DEM) whose raster the arrival times use"},
         {"arrival.format", "\"tif\"", "tif (GeoTIFF with CRS, NODATA, units) | asc (ESRI ASCII grid + .prj): "
@@ -151,6 +153,11 @@ class FireModel final : public VelocityModel {
         wind_v_file_ = w.path("v_file");
         wind_.u = read_dem(wind_u_file_);
         wind_.v = read_dem(wind_v_file_);
+        // A wind grid has no holes: its NODATA cells take the nearest valid value.
+        for (auto [grid, file] : {std::pair{&wind_.u, &wind_u_file_}, std::pair{&wind_.v, &wind_v_file_}})
+          if (const std::size_t filled = fill_nodata(*grid))
+            spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid wind", file->string(), filled,
+                         grid->heights.size());
       } else {
         w.accept("u_file");
         w.accept("v_file");
@@ -181,8 +188,17 @@ class FireModel final : public VelocityModel {
           throw InputError(std::string("[model.fuel] presets: ") + e.what());
         }
       }
+      non_burnable_.clear();
+      for (double code : f.numbers("non_burnable", {}, std::nullopt)) {
+        if (code != std::round(code) || std::abs(code) > 1e15)
+          throw InputError(fmt::format("[model.fuel] non_burnable: {} is not an integer fuel code", code));
+        non_burnable_.push_back(std::llround(code));
+      }
       fuel_file_ = map;
-      if (!map.empty()) fuel_map_ = read_dem(map);
+      if (!map.empty()) {
+        fuel_map_ = read_dem(map);
+        check_fuel_codes();
+      }
       f.reject_unknown();
     }
     if (const toml::table* arrival = p.table("arrival")) {
@@ -383,16 +399,39 @@ class FireModel final : public VelocityModel {
     write_polygon_layer(output_dir / perimeter_file_, layer);
   }
 
-  // Fuel at a point: the uniform fuel, or the map's code (0 = not burnable → null).
+  bool non_burnable(long long code) const {
+    return code == 0 || std::find(non_burnable_.begin(), non_burnable_.end(), code) != non_burnable_.end();
+  }
+
+  // Every cell of the fuel map is NODATA, a non-burnable code or the number of a preset: any other
+  // value is an error naming its cell (before, codes without a preset silently did not burn).
+  void check_fuel_codes() const {
+    for (std::size_t row = 0; row < fuel_map_.rows; ++row)
+      for (std::size_t col = 0; col < fuel_map_.cols; ++col) {
+        if (!fuel_map_.valid(row, col)) continue;
+        const double value = fuel_map_.at(row, col);
+        const bool integer = value == std::round(value) && std::abs(value) < 1e15;
+        if (integer && (non_burnable(std::llround(value)) || (value >= 1 && value <= double(fuels_.size())))) continue;
+        throw InputError(fmt::format("{}: the fuel code {} of the cell at row {}, column {} is neither a preset's number "
+                                     "(1 to {}: [model.fuel] presets) nor 0, NODATA ({}) or a code of [model.fuel] "
+                                     "non_burnable",
+                                     fuel_file_.string(), value, row + 1, col + 1, fuels_.size(), fuel_map_.nodata));
+      }
+  }
+
+  // Fuel at a point: the uniform fuel, or the map's code (NODATA, 0 and the non-burnable codes → null).
   const BalbiParameters* fuel_at(const Vec3& x) const {
     if (fuel_map_.cols == 0) return fuels_.empty() ? &base_ : &fuels_.front();
-    long code = std::lround(raster_nearest(fuel_map_, x[0], x[1]));
-    if (code <= 0 || std::size_t(code) > fuels_.size()) return nullptr;
+    const double value = raster_nearest(fuel_map_, x[0], x[1]);
+    if (std::isnan(value) || value == fuel_map_.nodata) return nullptr;  // no data is no fuel
+    const long long code = std::llround(value);
+    if (non_burnable(code) || code < 1 || std::size_t(code) > fuels_.size()) return nullptr;
     return &fuels_[std::size_t(code) - 1];
   }
 
   BalbiParameters base_;
   std::vector<BalbiParameters> fuels_;
+  std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA
   HeightGrid fuel_map_;
   WindField wind_;
   double arrival_cell_ = 0;

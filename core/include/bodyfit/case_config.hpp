@@ -2,7 +2,7 @@
 // A run case: the TOML file read by `bodyfit run` (reference: docs/running.md).
 //
 //   [surface]    file = "s.mesh"  |  generator = "sphere" (faces|h, radius) | "terrain" (extent, h,
-//                seed, dem, max_height, feature_size) | "plane" (size, h)
+//                seed, dem, nodata, reproject, max_height, feature_size) | "plane" (size, h)
 //   [region]     shape = "refs" (refs = [3]) | "sol" (sol = "phi.sol") | "cap" (axis, angle in
 //                degrees, center; or axes = [[..], ..] and angles = [..] for a union of caps) | "disks" (centers = [[x, y], ...], radii = [...])
 //                | "balls" (centers = [[x, y, z], ...], radii = [...]: S inside the balls)
@@ -47,6 +47,8 @@ struct SurfaceSpec {
   SphereOptions sphere;             ///< Kind::Sphere
   TerrainOptions terrain;           ///< Kind::Terrain (procedural, or from `dem`)
   std::filesystem::path dem;        ///< Kind::Terrain: a DEM raster instead of the procedural landscape
+  NodataMode nodata = NodataMode::hole;      ///< with `dem`: what its NODATA cells become
+  Reprojection reproject = Reprojection::none;  ///< with `dem`: a raster in degrees refused, or warped to UTM
   PlaneOptions plane;               ///< Kind::Plane
 };
 

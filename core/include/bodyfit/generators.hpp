@@ -40,8 +40,28 @@ struct HeightGrid {
   /// "" when unknown. read_dem refuses a geographic one (degrees are not metres).
   std::string crs;
   double at(std::size_t row, std::size_t col) const { return heights[row * cols + col]; }
-  /// Bilinear interpolation at (x, y), cell-centre registered; clamps outside the grid.
+  /// Whether the cell holds data (neither NaN nor the NODATA value).
+  bool valid(std::size_t row, std::size_t col) const;
+  /// Bilinear interpolation at (x, y), cell-centre registered; clamps outside the grid. NODATA
+  /// cells take no part (the weights of the valid ones are renormalised); NaN when the four
+  /// cells around (x, y) are all NODATA.
   double sample(double x, double y) const;
+};
+
+/// The NODATA cells of a raster (NaN or the NODATA value).
+std::size_t count_nodata(const HeightGrid& grid);
+/// Gives every NODATA cell the value of its nearest valid cell (breadth-first over the
+/// 8-neighbourhood from all valid cells at once, ties by scan order); returns how many it filled.
+/// A raster without any valid cell is left as it is.
+std::size_t fill_nodata(HeightGrid& grid);
+
+/// What read_dem does with a raster in degrees (a geographic coordinate system).
+enum class Reprojection {
+  none,  ///< refuse it, naming the UTM zone to project it to
+  utm,   ///< warp it to the WGS 84 / UTM zone of its centre (GDAL's warper, bilinear, NODATA kept)
+};
+struct DemReadOptions {
+  Reprojection reproject = Reprojection::none;
 };
 
 /// ESRI ASCII grid (.asc). Errors name the file and line.
@@ -49,8 +69,9 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file);
 void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid);
 /// GeoTIFF through GDAL; throws InputError when bodyfit was built without GDAL.
 HeightGrid read_geotiff(const std::filesystem::path& file);
-/// Dispatch on extension (.asc, .tif/.tiff).
-HeightGrid read_dem(const std::filesystem::path& file);
+/// Dispatch on extension (.asc, .tif/.tiff); NODATA cells are kept as they are (a raster whose
+/// cells are all NODATA is an error). A geographic raster is refused, or reprojected on request.
+HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options = {});
 /// An InputError naming both files when two rasters of one case have different coordinate systems
 /// (an unknown one, "", matches any).
 void require_same_crs(const HeightGrid& a, const std::filesystem::path& file_a, const HeightGrid& b,
@@ -68,7 +89,26 @@ struct TerrainOptions {
 SurfaceMesh make_terrain(const TerrainOptions& options = {});
 /// The height function of the procedural landscape (the surface's exact z(x, y)).
 double terrain_height(const TerrainOptions& options, double x, double y);
-/// Terrain from a DEM raster at edge length h (0: the raster's cell size).
+/// What the NODATA cells of a DEM become in its terrain.
+enum class NodataMode {
+  hole,  ///< no terrain: the surface covers the valid cells only, its boundary follows the mask
+  fill,  ///< the nearest valid height (fill_nodata): the surface covers the whole rectangle
+};
+struct GridTerrainOptions {
+  double h = 0;                    ///< target edge length (0: the raster's cell size)
+  NodataMode nodata = NodataMode::hole;
+  /// hole: connected pieces of the surface smaller than this (plan-view area, m²) are dropped;
+  /// < 0: 16·h² (a square of 4 × 4 edges).
+  double min_island_area = -1;
+};
+/// Terrain from a DEM raster: a lattice of near-equilateral triangles of edge ≈ h over the raster's
+/// rectangle, heights by bilinear interpolation over valid cells. With NODATA as holes, a lattice
+/// triangle is kept when its vertices, edge midpoints and centroid all lie over valid cells (closed
+/// squares); then vertices where several fans of triangles meet keep only their largest fan (the
+/// surface is a manifold) and pieces below min_island_area are dropped. An InputError when nothing
+/// is left.
+SurfaceMesh make_terrain_from_grid(const HeightGrid& grid, const GridTerrainOptions& options);
+/// Terrain from a DEM raster at edge length h (0: the raster's cell size), NODATA as holes.
 SurfaceMesh make_terrain_from_grid(const HeightGrid& grid, double h = 0);
 
 }  // namespace bodyfit
