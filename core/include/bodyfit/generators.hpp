@@ -46,6 +46,9 @@ struct HeightGrid {
 
 /// ESRI ASCII grid (.asc). Errors name the file and line.
 HeightGrid read_esri_ascii(const std::filesystem::path& file);
+/// The values of an ESRI ASCII grid as they are, NODATA cells kept (as grid.nodata): for rasters
+/// of results such as arrival times, where NODATA means "never reached", not a missing height.
+HeightGrid read_esri_ascii_values(const std::filesystem::path& file);
 void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid);
 /// GeoTIFF through GDAL; throws InputError when bodyfit was built without GDAL.
 HeightGrid read_geotiff(const std::filesystem::path& file);
