@@ -4,12 +4,15 @@
 #include "balbi.hpp"
 #include "fire_maps.hpp"
 
+#include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/map.hpp>
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -229,6 +232,18 @@ class FireModel final : public VelocityModel {
 
   void finish(const std::filesystem::path& output_dir) override {
     if (arrival_.initialised() && !output_dir.empty()) arrival_.write(output_dir / "arrival_time.asc", crs_);
+    // The run's map (docs/fire.md, "Maps"), drawn from the files just written. A map that cannot be
+    // drawn (no Cairo) costs the run nothing: its results are all written.
+    // Only after `bodyfit run`, which writes final.mesh first; not when a program calls evolve().
+    if (!arrival_.initialised() || output_dir.empty() || !config::have_cairo ||
+        !std::filesystem::exists(output_dir / "final.mesh"))
+      return;
+    try {
+      RunMap run = load_run_map(output_dir);
+      draw_fire_map(output_dir / "fire_map.png", run.mesh, run.layers, {.title = "Fire map: burnt area and arrival time"});
+    } catch (const std::exception& e) {
+      spdlog::warn("fire_map.png not drawn: {}", e.what());
+    }
   }
 
  private:
