@@ -91,6 +91,7 @@ TEST_CASE("map: nice steps, time labels, automatic isochrone levels") {
   // Arrivals from 42 s to 8485 s: span / 7 = 1206 s, above 30 min once rounded up in minutes
   // (50), so half-hours: 0.5, 1, 1.5 and 2 h.
   const HeightGrid arrival = radial_arrival();
+  CHECK(isochrone_interval(arrival, options) == 1800);
   CHECK(isochrone_levels(arrival, options) == std::vector<double>{1800, 3600, 5400, 7200});
   options.isochrone_interval = 3600;
   CHECK(isochrone_levels(arrival, options) == std::vector<double>{3600, 7200});
@@ -98,6 +99,7 @@ TEST_CASE("map: nice steps, time labels, automatic isochrone levels") {
   HeightGrid none = arrival;
   for (double& t : none.heights) t = std::nan("");
   CHECK(isochrone_levels(none, options).empty());
+  CHECK(isochrone_interval(none, options) == 0);
 }
 
 TEST_CASE("map: isochrones of exact fields (marching squares)") {

@@ -141,7 +141,7 @@ void draw_burnt_area(cairo_t* cr, const SurfaceMesh& mesh, const MapLayout& layo
 
 void draw_isochrones(cairo_t* cr, const MapLayers& layers, const std::vector<double>& levels, const MapLayout& layout,
                      const MapOptions& options, const Fonts& fonts) {
-  const double interval = levels.size() > 1 ? levels[1] - levels[0] : levels.front();
+  const double interval = isochrone_interval(layers.arrival, options);
   std::vector<std::vector<std::array<Vec3, 2>>> lines;
   for (double level : levels) lines.push_back(isochrone_segments(layers.arrival, level));
   auto add_segments = [&](const std::vector<std::array<Vec3, 2>>& segments) {
@@ -243,7 +243,7 @@ void draw_north_arrow(cairo_t* cr, const MapLayout& layout, const Fonts& fonts) 
   draw_text(cr, x - text_width(cr, "N") / 2, y - size - 4, "N");
 }
 
-void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const std::vector<double>& levels,
+void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, bool burnt, const std::vector<double>& levels,
                  const MapLayout& layout, const MapOptions& options, const Fonts& fonts) {
   const double x = layout.legend_left + 10, swatch = 1.6 * fonts.body, line = 1.7 * fonts.body;
   double y = layout.panel_top + fonts.body;
@@ -254,7 +254,7 @@ void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, 
   };
   text_at(0, "Legend", true);
   y += 1.5 * line;
-  if (layers.burnt_area && mesh.has_regions()) {
+  if (burnt) {
     cairo_set_source_rgb(cr, 0.75, 0.75, 0.75);
     cairo_rectangle(cr, x, y - swatch / 3, swatch, 2 * swatch / 3);
     cairo_fill(cr);
@@ -280,7 +280,7 @@ void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, 
     y += 0.4 * line;
     text_at(0, "Arrival time (isochrones)", true);
     y += line;
-    const double interval = levels.size() > 1 ? levels[1] - levels[0] : levels.front();
+    const double interval = isochrone_interval(layers.arrival, options);
     for (std::size_t i = 0; i < levels.size(); ++i) {
       if (y > bottom - 3 * line) {
         text_at(swatch + 8, fmt::format("... {} more", levels.size() - i));
@@ -335,6 +335,12 @@ void draw_title_and_caption(cairo_t* cr, const MapLayers& layers, const MapLayou
   draw_text(cr, layout.panel_left, layout.height - 0.6 * fonts.small, caption, false, {60, 60, 60});
 }
 
+bool any_burnt(const SurfaceMesh& mesh) {
+  for (auto f : mesh.faces())
+    if (mesh.inside(f)) return true;
+  return false;
+}
+
 void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const MapOptions& options) {
   double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
   for (auto v : mesh.vertices()) {
@@ -354,7 +360,8 @@ void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const M
                   layout.panel_bottom - layout.panel_top);
   cairo_clip(cr);
   draw_hillshade(cr, mesh, layout, options);
-  if (layers.burnt_area && mesh.has_regions()) draw_burnt_area(cr, mesh, layout, options);
+  const bool burnt = layers.burnt_area && mesh.has_regions() && any_burnt(mesh);
+  if (burnt) draw_burnt_area(cr, mesh, layout, options);
   if (!levels.empty()) draw_isochrones(cr, layers, levels, layout, options, fonts);
   for (const Vec3& p : layers.ignitions) draw_star(cr, layout.to_pixel(p[0], p[1]), 9, options.ignition_color);
   cairo_restore(cr);
@@ -366,7 +373,7 @@ void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const M
   cairo_stroke(cr);
   draw_scale_bar(cr, layout, fonts);
   draw_north_arrow(cr, layout, fonts);
-  draw_legend(cr, mesh, layers, levels, layout, options, fonts);
+  draw_legend(cr, mesh, layers, burnt, levels, layout, options, fonts);
   draw_title_and_caption(cr, layers, layout, options, fonts);
 }
 

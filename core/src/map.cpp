@@ -105,6 +105,11 @@ ScaleBar scale_bar(const MapLayout& layout) {
   return bar;
 }
 
+double isochrone_interval(const HeightGrid& arrival, const MapOptions& options) {
+  double earliest = 0, latest = 0;
+  return interval_for(arrival, options, earliest, latest);
+}
+
 std::vector<double> isochrone_levels(const HeightGrid& arrival, const MapOptions& options) {
   double earliest = 0, latest = 0;
   const double interval = interval_for(arrival, options, earliest, latest);

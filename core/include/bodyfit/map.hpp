@@ -79,6 +79,9 @@ ScaleBar scale_bar(const MapLayout& layout);
 /// The largest of 1, 2, 5 × 10^k not above `value` (> 0).
 double nice_step_below(double value);
 
+/// The isochrone spacing in seconds: the options' or the automatic one over the raster's span
+/// (0 when fewer than two distinct arrival times).
+double isochrone_interval(const HeightGrid& arrival, const MapOptions& options);
 /// The isochrone times, in seconds: multiples of the interval (the given one or the automatic
 /// one, see MapOptions) strictly between the earliest and the latest arrival of the raster.
 std::vector<double> isochrone_levels(const HeightGrid& arrival, const MapOptions& options);
