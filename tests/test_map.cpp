@@ -156,7 +156,7 @@ TEST_CASE("map: the layout keeps the aspect ratio and maps the box onto the pane
   CHECK(crs_name_of_wkt("").empty());
 }
 
-TEST_CASE("map: without Cairo, a clear error; with it, the hillshade's grey of a plane is Lambert's") {
+TEST_CASE("map: without Cairo a clear error, with it the hillshade grey of a plane is Lambert") {
   test::TempDir dir("map_hillshade");
   SurfaceMesh plane = make_plane({.size = 1000, .h = 50});
   if constexpr (!config::have_cairo) {
@@ -276,7 +276,7 @@ TEST_CASE("map: a burnt disk, radial isochrones and the scale bar where the layo
   CHECK(close_to(image.at(int(std::floor(centre.x)), int(std::floor(centre.y)) + 2), options.ignition_color, 8));
 }
 
-TEST_CASE("bodyfit map: a run directory's final mesh, arrival times and ignitions; errors exit 1") {
+TEST_CASE("bodyfit map: a run directory (final mesh, arrival times, ignitions), and errors exit 1") {
   if constexpr (!config::have_cairo) return;
   test::TempDir dir("map_command");
   fs::create_directories(dir / "run");
