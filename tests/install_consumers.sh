@@ -10,7 +10,9 @@
 #     too; its C++ program linked to bodyfit::bodyfit_core searches the prefix's plugin directory
 #     (not the build tree's) and BODYFIT_PLUGIN_PATH first;
 #  4. the GDAL module (when built) is installed beside the plugin directory and the installed bodyfit,
-#     which does not link GDAL, loads it to read a GeoTIFF.
+#     which does not link GDAL, loads it to read a GeoTIFF;
+#  5. the map module (when built) likewise: the installed bodyfit, which does not link Cairo, draws
+#     a map with it.
 #   usage: install_consumers.sh <bodyfit build dir> <bodyfit source dir>
 set -euo pipefail
 build=$(cd "$1" && pwd)
@@ -200,6 +202,15 @@ if [[ -f "$build/lib/bodyfit/libbodyfit_gis.so" ]]; then
     "$prefix/bin/bodyfit" -q mesh terrain --dem "$work/hill.tif" -o "$work/hill.mesh" || fail "bodyfit mesh terrain --dem hill.tif"
     [[ -s "$work/hill.mesh" ]] || fail "no mesh from the GeoTIFF"
   fi
+fi
+
+if [[ -f "$build/lib/bodyfit/libbodyfit_map.so" ]]; then
+  step "the map module: installed in $libdir/bodyfit, loaded on first use by the installed bodyfit"
+  [[ -f "$libdir/bodyfit/libbodyfit_map.so" ]] || fail "libbodyfit_map.so not installed in $libdir/bodyfit"
+  ldd "$prefix/bin/bodyfit" | grep -qi cairo && fail "the installed bodyfit links Cairo (it must load it on demand)"
+  "$prefix/bin/bodyfit" -q mesh terrain --extent 2000 --h 200 -o "$work/small.mesh" || fail "bodyfit mesh terrain"
+  "$prefix/bin/bodyfit" -q map "$work/small.mesh" -o "$work/small_map.png" --size 400x300 || fail "bodyfit map"
+  [[ -s "$work/small_map.png" ]] || fail "no map drawn"
 fi
 
 echo "install consumers: OK"

@@ -13,6 +13,7 @@
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
 #include <bodyfit/vector_io.hpp>
+#include <bodyfit/render.hpp>
 
 #include "gis_module.hpp"
 #include "test_support.hpp"
@@ -375,6 +376,11 @@ TEST_CASE("[model] file names are relative to the case file: a run from another 
   INFO(first.output);
   CHECK(first.exit_code == 0);
   CHECK(fs::exists(dir / "elsewhere" / "out" / (config::have_gdal ? "arrival_time.tif" : "arrival_time.asc")));
+  if constexpr (config::have_cairo) {  // the model's map of the run, drawn at its end (docs/fire.md, "Maps")
+    const Image map = read_png(dir / "elsewhere" / "out" / "fire_map.png");
+    CHECK(map.width == 1200);
+    CHECK(map.height == 900);
+  }
   CHECK(history_rows().size() == 4);  // header, states 0..2
 
   // --resume reads the case given on its command line again: from a third directory, same files.

@@ -216,7 +216,7 @@ HeightGrid reproject_to_utm(HeightGrid grid, const std::filesystem::path& file) 
 
 }  // namespace
 
-HeightGrid read_esri_ascii(const std::filesystem::path& file) {
+HeightGrid read_esri_ascii_values(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw file_error(file, "cannot open for reading");
   HeightGrid grid;
@@ -304,9 +304,14 @@ HeightGrid read_esri_ascii(const std::filesystem::path& file) {
   if (grid.heights.size() < expected)
     throw file_error(file, line_no, fmt::format("truncated: expected {} values ({} rows × {} columns), found {}",
                                                 expected, grid.rows, grid.cols, grid.heights.size()));
+  grid.crs = read_prj(file);
+  return grid;
+}
+
+HeightGrid read_esri_ascii(const std::filesystem::path& file) {
+  HeightGrid grid = read_esri_ascii_values(file);
   require_some_data(grid, file);
   check_heights(grid, file);
-  grid.crs = read_prj(file);
   return grid;
 }
 

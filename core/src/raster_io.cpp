@@ -38,4 +38,16 @@ void write_raster(const std::filesystem::path& file, const HeightGrid& grid, con
   }
 }
 
+HeightGrid read_raster_values(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".asc") return read_esri_ascii_values(file);
+  if (ext != ".tif" && ext != ".tiff")
+    throw file_error(file, "unknown raster format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  HeightGrid grid;
+  std::string error;
+  if (!gis::module_for(file).read_raster(file, grid, error)) throw file_error(file, error);
+  return grid;
+}
+
 }  // namespace bodyfit

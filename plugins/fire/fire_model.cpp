@@ -8,6 +8,7 @@
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/map.hpp>
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/plan_geometry.hpp>
 #include <bodyfit/raster_io.hpp>
@@ -351,6 +352,18 @@ class FireModel final : public VelocityModel {
                     .items = items});
     }
     write_perimeters(output_dir);
+    // The run's map (docs/fire.md, "Maps"), drawn from the files just written. A map that cannot be
+    // drawn (no Cairo) costs the run nothing: its results are all written.
+    // Only after `bodyfit run`, which writes final.mesh first; not when a program calls evolve().
+    if (!arrival_.initialised() || output_dir.empty() || !config::have_cairo ||
+        !std::filesystem::exists(output_dir / "final.mesh"))
+      return;
+    try {
+      RunMap run = load_run_map(output_dir);
+      draw_fire_map(output_dir / "fire_map.png", run.mesh, run.layers, {.title = "Fire map: burnt area and arrival time"});
+    } catch (const std::exception& e) {
+      spdlog::warn("fire_map.png not drawn: {}", e.what());
+    }
   }
 
  private:

@@ -64,8 +64,12 @@ struct DemReadOptions {
   Reprojection reproject = Reprojection::none;
 };
 
-/// ESRI ASCII grid (.asc). Errors name the file and line.
+/// ESRI ASCII grid (.asc) as a terrain: NODATA kept, some data and plausible heights required.
+/// Errors name the file and line.
 HeightGrid read_esri_ascii(const std::filesystem::path& file);
+/// The values of an ESRI ASCII grid as they are (NODATA as grid.nodata), without a terrain's checks: for rasters
+/// of results such as arrival times, where NODATA means "never reached", not a missing height.
+HeightGrid read_esri_ascii_values(const std::filesystem::path& file);
 void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid);
 /// GeoTIFF through GDAL; throws InputError when bodyfit was built without GDAL.
 HeightGrid read_geotiff(const std::filesystem::path& file);

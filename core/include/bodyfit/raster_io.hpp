@@ -32,4 +32,9 @@ struct RasterMetadata {
 /// IoError when the file cannot be written.
 void write_raster(const std::filesystem::path& file, const HeightGrid& grid, const RasterMetadata& metadata = {});
 
+/// A raster of values as written by write_raster (`.asc` + its .prj, or a GeoTIFF through GDAL),
+/// NODATA cells kept as grid.nodata, without a terrain's checks: for results such as arrival times,
+/// where NODATA means "never reached". InputError naming the file when it cannot be read.
+HeightGrid read_raster_values(const std::filesystem::path& file);
+
 }  // namespace bodyfit
