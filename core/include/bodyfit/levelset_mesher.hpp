@@ -30,6 +30,11 @@ struct DiscretizeOptions {
   /// the edge; otherwise, and when false, the zero of the linear interpolant (the paper's and
   /// mmgs's rule; exact for φ affine along the edge, where both agree).
   bool hermite_crossings = true;
+  /// The Hermite slopes: true = the gradient of a least-squares quadratic through φ on the two
+  /// rings of each vertex (second order on any mesh); false = the averaged face gradients
+  /// (vertex_gradient), first order on an irregular mesh, whose scatter of the cut points was
+  /// turned into a steady loss of area by the remesher (docs/validation/drift.md).
+  bool fitted_slopes = true;
   /// Specks: a connected part of either region whose area is below speck_area·h² (h the mean edge
   /// length of the input mesh) is given to the region around it, so its interface disappears.
   /// Such a part is below what the mesh resolves (a noise-born island of φ a fraction of one
