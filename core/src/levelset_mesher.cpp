@@ -25,7 +25,9 @@ double zero_fraction(double a, double b) { return a / (a - b); }
 double hermite_zero_fraction(double fa, double fb, double ma, double mb) {
   const double linear = zero_fraction(fa, fb);
   const double secant = fb - fa;
-  if (ma * secant <= 0 || mb * secant <= 0) return linear;
+  // A slope at rounding level (a fitted gradient where the exact one is 0) says nothing: linear.
+  const double tiny = 1e-12 * secant * secant;
+  if (ma * secant <= tiny || mb * secant <= tiny) return linear;
   double t = linear;
   for (int iteration = 0; iteration < 8; ++iteration) {
     const double t2 = t * t, t3 = t2 * t;
