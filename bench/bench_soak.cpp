@@ -32,19 +32,22 @@ int main(int argc, char** argv) {
   long every = 100;
   bench::Arguments args("bench_soak",
                         "usage: bench_soak [--h 0.08] [--iterations 3000] [--period 4] [--depth 0.7] [-o soak.csv] "
-                        "[--every 100]\n"
+                        "[--every 100] [--slopes fitted|faces|linear]\n"
                         "  Two overlapping caps (55 deg, axes 90 deg apart) on the unit sphere go in by depth (radians)\n"
                         "  (the exact |G| is known on the way in and at the end of each period; NaN on the way out)\n"
                         "  and back out once per period, splitting and merging; one CSV row per iteration: time, |G|,\n"
                         "  the exact |G|, relative area error, components, faces, vertices, min quality, share of\n"
-                        "  faces below 0.3, resident memory (MiB). --every: print a line every that many iterations.\n");
+                        "  faces below 0.3, resident memory (MiB). --every: print a line every that many iterations.\n"
+                        "  --slopes: the cut's Hermite slopes ([discretize] fitted_slopes, hermite_crossings).\n");
   args.option("--h", c.h);
   args.option("--iterations", c.iterations);
   args.option("--period", c.period);
   args.option("--depth", c.depth);
   args.option("-o", csv_path);
   args.option("--every", every);
+  args.option("--slopes", c.slopes);
   args.parse(argc, argv);
+  if (c.slopes != "fitted" && c.slopes != "faces" && c.slopes != "linear") args.fail("--slopes: fitted, faces or linear");
   if (!(c.h > 0) || c.iterations < 1 || !(c.period > 0) || !(c.depth > 0) || every < 1)
     args.fail("--h, --iterations, --period, --depth and --every must be positive");
   spdlog::set_level(spdlog::level::warn);

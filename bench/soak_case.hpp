@@ -41,6 +41,7 @@ struct SoakCase {
   double cap_angle = 55;   ///< degrees
   double separation = 90;  ///< angle between the two axes, degrees
   long iterations = 3000;
+  std::string slopes = "fitted";  ///< the cut's Hermite slopes: fitted, faces or linear (no Hermite)
 
   double speed() const { return depth * kPi / period; }  ///< δ/2 · 2π/P
   /// S(t): the front's displacement (≤ 0) at time t.
@@ -70,10 +71,14 @@ cfl = {cfl}
 iterations = {n}
 [remesh]
 hmax = {h}
+[discretize]
+hermite_crossings = {hermite}
+fitted_slopes = {fitted}
 )",
                        a0[0], a0[1], a0[2], a1[0], a1[1], a1[2], fmt::arg("h", h), fmt::arg("a", cap_angle),
                        fmt::arg("speed", speed()), fmt::arg("P", period), fmt::arg("cfl", cfl),
-                       fmt::arg("n", iterations));
+                       fmt::arg("n", iterations), fmt::arg("hermite", slopes != "linear"),
+                       fmt::arg("fitted", slopes == "fitted"));
   }
 };
 
@@ -144,8 +149,8 @@ class ExactArea {
       }
       P3 foot;
       for (int k = 0; k < 3; ++k) foot[std::size_t(k)] = std::cos(a) * u[std::size_t(k)] + std::sin(a) * t[std::size_t(k)] / lt;
-      if (angle(foot, other) >= a)
-        d = std::min(d, a - beta);
+      if (angle(foot, other) >= a)  // |a − β|: x may lie in cap j outside cap i (β > a)
+        d = std::min(d, std::abs(a - beta));
       else  // the nearest point of the arc of circle i on ∂G(0) is one of its ends, the corners
         d = std::min({d, angle(x, corners_[0]), angle(x, corners_[1])});
     }
