@@ -36,7 +36,7 @@ TEST_CASE("soak: the exact |G(0)| is the area of the union of the two caps") {
   CHECK(exact.initial() == doctest::Approx(area).epsilon(1e-4));  // the bench's grid is 0.35°: second order
 }
 
-TEST_CASE("soak (short): two caps split and merge for 400 iterations; area, quality, faces and memory stay bounded") {
+TEST_CASE("soak (short): two caps split and merge for 400 iterations, area, quality, faces and memory stay bounded") {
   soak::SoakCase c;
   c.h = 0.1;
   c.period = 4;  // Δt = 0.05: 80 steps per period, 5 periods
