@@ -51,7 +51,7 @@ struct Row {
   StageTimes ms;  // summed over the iterations
 };
 
-Row run_one(double h, double c) {
+Row run_one(double h, double c, const std::string& slopes) {
   const std::string text = fmt::format(R"(
 [surface]
 generator = "sphere"
@@ -67,8 +67,12 @@ cfl = {c}
 final_time = {T:.17g}
 [remesh]
 hmax = {h}
+[discretize]
+hermite_crossings = {hermite}
+fitted_slopes = {fitted}
 )",
-                                       fmt::arg("h", h), fmt::arg("c", c), fmt::arg("T", kPi / 2 - kCapAngle));
+                                       fmt::arg("h", h), fmt::arg("c", c), fmt::arg("T", kPi / 2 - kCapAngle),
+                                       fmt::arg("hermite", slopes != "linear"), fmt::arg("fitted", slopes == "fitted"));
   CaseConfig config = parse_case(toml::parse(text));
   LoadedModel model = load_model(config.model);
   configure_model(model, config.model_parameters);
@@ -100,19 +104,22 @@ hmax = {h}
 int main(int argc, char** argv) {
   std::vector<double> hs{0.2, 0.1, 0.05, 0.025};
   std::vector<double> cs{0.1, 0.25, 0.5, 0.75, 1.0};
-  std::string outdir = "bench_conormal_out";
+  std::string outdir = "bench_conormal_out", slopes = "fitted";
   double max_seconds = 1e30;  // skip the remaining (finer) runs of a c once one run took longer
   bench::Arguments args("bench_conormal",
-                        "usage: bench_conormal [--h 0.2,0.1,...] [--c 0.1,0.25,...] [-o outdir] [--max-seconds S]\n"
+                        "usage: bench_conormal [--h 0.2,0.1,...] [--c 0.1,0.25,...] [-o outdir] [--max-seconds S] [--slopes fitted|faces|linear]\n"
                         "  --h            mesh sizes h (hmax = h; default 0.2,0.1,0.05,0.025)\n"
                         "  --c            CFL numbers c (dt = c h; default 0.1,0.25,0.5,0.75,1)\n"
                         "  -o             output directory: conormal.csv, conormal.png (default bench_conormal_out)\n"
-                        "  --max-seconds  skip the finer runs of a c once one run took longer than S\n");
+                        "  --max-seconds  skip the finer runs of a c once one run took longer than S\n"
+                        "  --slopes       the cut's Hermite slopes ([discretize] fitted_slopes, hermite_crossings)\n");
   args.option("--h", hs);
   args.option("--c", cs);
   args.option("-o", outdir);
   args.option("--max-seconds", max_seconds);
+  args.option("--slopes", slopes);
   args.parse(argc, argv);
+  if (slopes != "fitted" && slopes != "faces" && slopes != "linear") args.fail("--slopes: fitted, faces or linear");
   std::filesystem::create_directories(outdir);
   spdlog::set_level(spdlog::level::warn);
   std::sort(hs.begin(), hs.end(), std::greater<>());
@@ -125,7 +132,7 @@ int main(int argc, char** argv) {
              "c", "dt", "N", "faces", "E", "deficit%", "time s", "ms/iter");
   for (double c : cs) {
     for (double h : hs) {
-      Row r = run_one(h, c);
+      Row r = run_one(h, c, slopes);
       rows.push_back(r);
       const double per_iteration = r.iterations ? 1000 * (r.seconds - r.setup_seconds) / r.iterations : 0;
       fmt::print("{:>7.4g} {:>5.3g} {:>8.4g} {:>5} {:>7} {:>10.3e} {:>9.2f} {:>8.2f} {:>9.1f}   {:.2f} {:.2f} {:.2f} {:.2f} {:.2f}\n",

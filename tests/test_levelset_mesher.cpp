@@ -136,6 +136,74 @@ TEST_CASE("spherical cap: Hermite crossings are an order of magnitude closer to 
   CHECK(hermite_fine < 0.1 * linear_fine);
 }
 
+namespace {
+
+/// make_square(20) with every interior vertex moved by up to a quarter edge (a fixed seed): an
+/// irregular mesh, on which the averaged face gradients are only first order.
+SurfaceMesh jittered_square() {
+  SurfaceMesh mesh = make_square(20);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> shift(-0.0125, 0.0125);
+  for (auto v : mesh.vertices())
+    if (!mesh.is_boundary(v)) {
+      const double dx = shift(random), dy = shift(random);
+      mesh.set_point(v, mesh.point(v) + Vec3(dx, dy, 0));
+    }
+  return mesh;
+}
+
+}  // namespace
+
+TEST_CASE("fitted Hermite slopes: exact for a quadratic φ on an irregular mesh, refused across a kink") {
+  // φ = |p − c|² − r²: the quadratic through two rings reproduces it, so along every edge the cubic
+  // Hermite interpolant is φ itself and its zero is on the circle to rounding; the averaged face
+  // gradients are off by O(h) on this mesh and so are the cut points (by O(h²)).
+  const Vec3 centre(0.5, 0.5, 0);
+  auto circle = [&](const Vec3& p) { return (p - centre).sqrnorm() - 0.09; };
+  auto worst_offset = [&](bool fitted, DiscretizeReport& report) {
+    SurfaceMesh mesh = jittered_square();
+    const ScalarField phi = sample(mesh, circle);
+    DiscretizeOptions options;
+    options.snap_ratio = 0, options.fitted_slopes = fitted;
+    report = discretize(mesh, phi, options);
+    double worst = 0;
+    for (auto v : interface_vertices(mesh)) worst = std::max(worst, std::abs((mesh.point(v) - centre).norm() - 0.3));
+    return worst;
+  };
+  DiscretizeReport fitted_report, face_report;
+  const double fitted = worst_offset(true, fitted_report), faces = worst_offset(false, face_report);
+  MESSAGE("circle on a jittered grid: cut points off the circle by " << fitted << " (fitted) and " << faces << " (faces)");
+  CHECK(fitted < 1e-12);
+  CHECK(faces > 1e-6);
+  CHECK(fitted_report.refused_fits == 0);
+  CHECK(fitted_report.fitted_slopes > 0);
+  CHECK(face_report.fitted_slopes + face_report.refused_fits == 0);
+
+  // φ = |x − 1/2| − 0.03, a band 1.2 edges wide: linear on each side of its ridge x = 1/2, so a fit
+  // whose rings stay on one side is exact (residual 0, accepted), and only the vertices whose two
+  // rings straddle the ridge can be refused — some must be, or the kink would go undetected.
+  SurfaceMesh mesh = jittered_square();
+  const ScalarField phi = sample(mesh, [](const Vec3& p) { return std::abs(p[0] - 0.5) - 0.03; });
+  std::size_t ends = 0, straddling = 0;
+  for (auto v : mesh.vertices()) {
+    bool crossed = false;
+    for (auto w : mesh.vv_range(v)) crossed = crossed || (phi[v.idx()] < 0) != (phi[w.idx()] < 0);
+    if (!crossed) continue;
+    ++ends;
+    bool left = false, right = false;
+    for (auto w : mesh.vv_range(v))
+      for (auto x : mesh.vv_range(w)) (mesh.point(x)[0] < 0.5 ? left : right) = true;
+    straddling += left && right;
+  }
+  DiscretizeOptions options;
+  options.snap_ratio = 0;
+  const DiscretizeReport report = discretize(mesh, phi, options);
+  MESSAGE("band: " << report.refused_fits << " fits refused of " << ends << " (" << straddling << " straddle the ridge)");
+  CHECK(report.fitted_slopes + report.refused_fits == ends);
+  CHECK(report.refused_fits > 0);
+  CHECK(report.refused_fits <= straddling);
+}
+
 TEST_CASE("Hermite and linear crossings agree when φ is affine along the edges") {
   SurfaceMesh a = test::grid_square(12), b = test::grid_square(12);
   ScalarField phi = sample(a, [](const Vec3& p) { return 0.7 * p[0] - 0.4 * p[1] - 0.1234; });

@@ -177,9 +177,12 @@ TEST_CASE("conormal plugin: V = speed * conormal, tangential; unknown keys refus
   LoadedModel model = load_model("conormal");
   CHECK(model->name() == "conormal");
   auto params = model->parameters();
-  REQUIRE(params.size() == 1);
+  REQUIRE(params.size() == 3);
   CHECK(params[0].name == "speed");
   CHECK(params[0].default_value == "1");
+  CHECK(params[1].name == "period");  // the periodic mode (issue 14): speed·cos(2πt/period + phase)
+  CHECK(params[2].name == "phase");
+  CHECK(contains(error_of([&] { configure_model(model, parse("phase = 90")); }), "applies only with a period > 0"));
 
   std::string message = error_of([&] { configure_model(model, parse("sped = 2")); });
   CHECK(contains(message, "bodyfit_conormal.so: configure failed: "));

@@ -212,7 +212,9 @@ class Evolution {
     StepGeometry geometry;
     const double cap = options_.max_cfl * cfl_length();
     const double longest = edge_length_stats(mesh_).max;
-    const double traced_width = cap + 2 * longest;  // the front cannot reach further within a sub-step
+    // The front cannot reach further within a sub-step, and the cut reads φ two rings beyond the
+    // vertices of its crossed edges (DiscretizeOptions::fitted_slopes): 3 edges, not 2.
+    const double traced_width = cap + 3 * longest;
     const double width = traced_width + cap + 2 * longest;  // where the traces read d and V
     ScalarField phi = distance_, next;
     std::vector<int> band = within(phi, width), traced;

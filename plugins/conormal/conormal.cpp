@@ -3,10 +3,21 @@
 // ∇_S d is the unit conormal n_Σ on the interface ∂G (pointing out of G) and extends it to the
 // whole surface as the gradient of the signed distance, so G grows at unit normal speed along the
 // geodesics normal to its boundary. `speed` scales it (a negative speed shrinks G).
+//
+// With `period` P > 0 the speed oscillates: V = speed·cos(2πt/P + phase)·∇_S d, so the front goes
+// out and back and a cap of polar angle a0 on the unit sphere has the exact polar angle
+//     a(t) = a0 + speed·P/(2π)·(sin(2πt/P + phase) − sin(phase)),
+// periodic in t (issue 14's drift test; bench/bench_drift, bench/bench_soak). The factor applied
+// over a step [t, t + Δt] is the mean of cos over it, so that a step moves a front at uniform
+// speed by the exact distance whatever Δt (with CFL sub-steps: the mean over what remains of the
+// step).
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
 
 namespace {
 
@@ -18,23 +29,41 @@ class ConormalModel final : public bodyfit::VelocityModel {
     return "V = speed * grad_S d: the unit conormal extended by the gradient of the signed distance (paper (4.1))";
   }
   std::vector<bodyfit::ParameterInfo> parameters() const override {
-    return {{"speed", "1", "factor multiplying V (length/time); a negative value shrinks G"}};
+    return {{"speed", "1", "factor multiplying V (length/time); a negative value shrinks G"},
+            {"period", "0", "period P of an oscillating speed speed*cos(2 pi t/P + phase) (time; 0: constant speed)"},
+            {"phase", "0", "phase of the oscillation (degrees; only with period)"}};
   }
   void configure(const toml::table& table) override {
     bodyfit::Parameters p(table, "model");
     speed_ = p.number("speed", 1.0);
+    period_ = p.number("period", 0.0, {.min = 0});
+    phase_ = p.number("phase", 0.0) * std::numbers::pi / 180;
+    if (period_ == 0 && p.has("phase")) p.fail("phase", "applies only with a period > 0");
     p.reject_unknown();
   }
   bodyfit::VelocityField compute(const bodyfit::StepContext& context) override {
+    const double factor = speed_ * oscillation(context.time(), context.dt());
     bodyfit::VectorField v = context.conormal();
-    for (auto& x : v) x *= speed_;
+    for (auto& x : v) x *= factor;
     auto field = bodyfit::VelocityField::tangential(std::move(v));
-    field.metrics.emplace_back("speed", speed_);
+    field.metrics.emplace_back("speed", factor);
     return field;
   }
 
  private:
+  /// The mean of cos(ωτ + phase) over [t, t + dt] (1 without a period).
+  double oscillation(double t, double dt) const {
+    if (period_ == 0) return 1.0;
+    const double omega = 2 * std::numbers::pi / period_;
+    if (!(dt > 0)) return std::cos(omega * t + phase_);
+    // sin(b) − sin(a) = 2 cos((a + b)/2) sin((b − a)/2): no cancellation for a small dt.
+    const double half = 0.5 * omega * dt;
+    return std::cos(omega * (t + 0.5 * dt) + phase_) * std::sin(half) / half;
+  }
+
   double speed_ = 1.0;
+  double period_ = 0.0;  ///< 0: constant speed
+  double phase_ = 0.0;   ///< radians
 };
 
 }  // namespace

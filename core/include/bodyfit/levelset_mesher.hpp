@@ -30,6 +30,16 @@ struct DiscretizeOptions {
   /// the edge; otherwise, and when false, the zero of the linear interpolant (the paper's and
   /// mmgs's rule; exact for φ affine along the edge, where both agree).
   bool hermite_crossings = true;
+  /// The Hermite slopes: true = the gradient of a least-squares quadratic through φ on the two
+  /// rings of each vertex (second order on any mesh); false = the averaged face gradients
+  /// (vertex_gradient), first order on an irregular mesh, whose scatter of the cut points was
+  /// turned into a steady loss of area by the remesher (docs/validation/drift.md).
+  bool fitted_slopes = true;
+  /// With fitted_slopes, the quadratic is trusted where it describes φ on the two rings: its
+  /// weighted RMS residual at most this fraction of the fitted slope times the rings' mean radius.
+  /// Above it φ has a kink within the rings (a distance's ridge: the middle of a part or a gap a
+  /// few edges wide, a corner of the front) and the vertex takes the averaged face gradient.
+  double fit_residual_limit = 0.05;
   /// Specks: a connected part of either region whose area is below speck_area·h² (h the mean edge
   /// length of the input mesh) is given to the region around it, so its interface disappears.
   /// Such a part is below what the mesh resolves (a noise-born island of φ a fraction of one
@@ -55,6 +65,10 @@ struct DiscretizeReport {
   /// than 0 or 2, or more than 1 on the boundary). Always 0; kept as a self-check.
   std::size_t pinched_vertices = 0;
   std::size_t removed_specks = 0;     ///< parts of a region given to the region around them (speck_area)
+  /// Hermite slopes taken from the quadratic fit, and those that fell back to the averaged face
+  /// gradient (too few neighbours, an ill-conditioned fit, or a residual above fit_residual_limit).
+  std::size_t fitted_slopes = 0;
+  std::size_t refused_fits = 0;
 };
 
 /// Cut the zero level set of `phi` (one value per vertex index) into `mesh`. Previous interface
