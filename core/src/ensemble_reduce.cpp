@@ -140,22 +140,27 @@ void write_member_table(const fs::path& file, const EnsembleRun& run, const std:
 }
 
 /// The burn probability from above: a block of pixels per cell, light grey where no member
-/// reached, the colormap over (0, 1] elsewhere, a colour bar and a title.
+/// reached, the colormap over (0, max] elsewhere (a probability map's values are mostly small),
+/// a colour bar and a title.
 void write_probability_picture(const fs::path& file, const HeightGrid& probability, std::size_t members) {
-  const int scale = std::max(1, int(720 / std::max(probability.cols, probability.rows)));
+  const int scale = std::max(1, int(900 / std::max(probability.cols, probability.rows)));
   const int width = int(probability.cols) * scale, height = int(probability.rows) * scale;
-  const int top = 40, bar = 90;
+  const int top = 40, bar = 110;
+  double highest = 0;
+  for (double p : probability.heights) highest = std::max(highest, p);
+  if (highest <= 0) highest = 1;
   Image image(width + bar + 20, height + top + 10);
   for (std::size_t r = 0; r < probability.rows; ++r)
     for (std::size_t c = 0; c < probability.cols; ++c) {
       const double p = probability.at(r, c);
-      const Rgb colour = p > 0 ? colormap(p) : Rgb{225, 225, 225};
+      const Rgb colour = p > 0 ? colormap(p / highest) : Rgb{225, 225, 225};
       image.fill_rect(int(c) * scale, top + int(r) * scale, int(c + 1) * scale, top + int(r + 1) * scale, colour);
     }
   const int x0 = width + 20;
-  for (int y = 0; y < height; ++y) image.fill_rect(x0, top + y, x0 + 20, top + y + 1, colormap(1.0 - double(y) / std::max(1, height - 1)));
-  image.text(x0 + 26, top, "1", {0, 0, 0}, 2);
-  image.text(x0 + 26, top + height / 2 - 7, "0.5", {0, 0, 0}, 2);
+  for (int y = 0; y < height; ++y)
+    image.fill_rect(x0, top + y, x0 + 20, top + y + 1, colormap(1.0 - double(y) / std::max(1, height - 1)));
+  image.text(x0 + 26, top, fmt::format("{:.3g}", highest), {0, 0, 0}, 2);
+  image.text(x0 + 26, top + height / 2 - 7, fmt::format("{:.3g}", highest / 2), {0, 0, 0}, 2);
   image.text(x0 + 26, top + height - 14, "0", {0, 0, 0}, 2);
   const std::string title = fmt::format("burn probability, {} members ({:.0f} m cells)", members, probability.cell_size);
   image.text(4, 8, title, {0, 0, 0}, Image::text_width(title, 2) + 8 <= image.width ? 2 : 1);
