@@ -56,6 +56,7 @@ void prepare_directory(const EnsembleOptions& options, const std::vector<std::st
   } else {
     write_atomically(recorded, [&](std::ostream& out) { out << identity; });
   }
+  remove_stale_temporaries(options.outdir);  // a reduction killed while writing
   remove_stale_temporaries(members);
   for (const auto& entry : fs::directory_iterator(members))
     if (entry.path().extension() == ".work") fs::remove_all(entry.path(), ec);
