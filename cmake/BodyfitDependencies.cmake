@@ -51,3 +51,14 @@ if(BODYFIT_WITH_CAIRO)
   endif()
 endif()
 message(STATUS "bodyfit: fire maps through Cairo: ${BODYFIT_HAVE_CAIRO}")
+# MPI is optional: `bodyfit ensemble` spreads members over ranks through a module loaded only
+# under an MPI launcher (core/mpi), never linked into the core or the program.
+set(BODYFIT_HAVE_MPI OFF)
+if(BODYFIT_WITH_MPI)
+  set(MPI_CXX_SKIP_MPICXX TRUE)  # the C API from C++, not the removed C++ bindings
+  find_package(MPI COMPONENTS CXX QUIET)
+  if(MPI_CXX_FOUND)
+    set(BODYFIT_HAVE_MPI ON)
+  endif()
+endif()
+message(STATUS "bodyfit: MPI ensembles: ${BODYFIT_HAVE_MPI}")

@@ -216,6 +216,28 @@ TEST_CASE("uniform wind on flat ground: the head moves at R(atan(|U|/u0))") {
   CHECK(500 - r0 - x_back == doctest::Approx(p.R0 * t).epsilon(0.03));
 }
 
+TEST_CASE("uniform wind as speed and direction: a wind from 270 degrees is velocity [U, 0], from 90 its mirror") {
+  auto extent_with = [](const std::string& wind) {
+    FireRun run = burn(inclined_plane(1600, 20, 0), {{800, 800, 150}}, "[wind]\ntype = 'uniform'\n" + wind, 10, 8, {}, 0.05);
+    return front_x_extent(run.mesh);
+  };
+  const auto velocity = extent_with("velocity = [15.0, 0.0]\n");
+  const auto from_west = extent_with("speed = 15.0\ndirection_deg = 270.0\n");
+  const auto from_east = extent_with("speed = 15.0\ndirection_deg = 90.0\n");
+  CHECK(from_west.first == doctest::Approx(velocity.first).epsilon(1e-9));
+  CHECK(from_west.second == doctest::Approx(velocity.second).epsilon(1e-9));
+  // From the east the head runs towards −x as far as it ran towards +x (up to the mesh's asymmetry).
+  CHECK(800 - from_east.first == doctest::Approx(velocity.second - 800).epsilon(0.02));
+  CHECK(from_east.second - 800 == doctest::Approx(800 - velocity.first).epsilon(0.02));
+  // speed and direction_deg are a uniform wind's, and not beside velocity.
+  LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
+  CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\nspeed = 3.0\ndirection_deg = 10.0\n")),
+                       doctest::Contains("apply to type = \"uniform\""), InputError);
+  CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nvelocity = [1.0, 0.0]\nspeed = 3.0\n"
+                                                          "direction_deg = 10.0\n")),
+                       doctest::Contains("either velocity or speed"), InputError);
+}
+
 TEST_CASE("four fires merge into one burnt region") {
   const double R0 = fire::BalbiParameters{}.R0;
   // Disks of 80 m, centres 300 m apart: they touch after (150 − 80)/R0 ≈ 176 s.

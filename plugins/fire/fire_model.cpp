@@ -110,6 +110,8 @@ class FireModel final : public VelocityModel {
         {"max_tilt_deg", "80", "cap on the tilt angle γ, degrees (< 90)"},
         {"wind.type", "\"none\"", "none | uniform | rotating | grid"},
         {"wind.velocity", "[0, 0]", "uniform wind (x, y), m/s"},
+        {"wind.speed, wind.direction_deg", "", "uniform wind as speed (m/s) and the direction it blows from (degrees "
+                                               "clockwise from north), instead of velocity"},
         {"wind.center", "(domain centre)", "rotating wind centre (x, y), m: U = scale·(y − yc, −(x − xc), 0)"},
         {"wind.scale", "0.001", "rotating wind angular rate, 1/s (m/s of wind per m from the centre)"},
         {"wind.u_file, wind.v_file", "", "gridded wind components, ESRI ASCII grids (m/s)"},
@@ -142,6 +144,15 @@ class FireModel final : public VelocityModel {
       wind_.type = w.choice("type", "none", {"none", "uniform", "rotating", "grid"});
       auto velocity = w.numbers("velocity", {0, 0}, 2);
       wind_.uniform = Vec3(velocity[0], velocity[1], 0);
+      // Or as a weather report gives it (what an ensemble samples): the speed and the direction
+      // the wind blows from, clockwise from north (a wind from 270° blows towards +x).
+      if (w.has("speed") || w.has("direction_deg")) {
+        if (wind_.type != "uniform") w.fail("speed", "speed and direction_deg apply to type = \"uniform\"");
+        if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
+        const double speed = w.required_number("speed", {.min = 0});
+        const double from = w.required_number("direction_deg") * kDegree;
+        wind_.uniform = Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
+      }
       auto center = w.numbers("center", {}, std::nullopt);
       if (!center.empty() && center.size() != 2) throw InputError("[model.wind] center: expected [x, y]");
       wind_.has_center = !center.empty();

@@ -1,0 +1,335 @@
+// bodyfit ensemble: members sampled from their index alone, the reduction's rasters, the same
+// bytes for any scheduling (sequential, threads, MPI ranks), restarts and failing members.
+#include <bodyfit/config.hpp>
+#include <bodyfit/ensemble.hpp>
+
+#include "test_support.hpp"
+
+#include <fmt/format.h>
+
+#include <doctest/doctest.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+using namespace bodyfit;
+using bodyfit::test::read_file;
+using bodyfit::test::run_bodyfit;
+using bodyfit::test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A small procedural terrain (about 400 faces), a uniform wind, 4 steps of 2 minutes.
+constexpr const char* kCase = R"(
+[surface]
+generator = "terrain"
+extent = 1200.0
+h = 100.0
+seed = 3
+max_height = 100.0
+feature_size = 600.0
+
+[region]
+shape = "disks"
+centers = [[600.0, 600.0]]
+radii = [150.0]
+
+[model]
+name = "fire"
+[model.wind]
+type = "uniform"
+speed = 3.0
+direction_deg = 250.0
+[model.arrival]
+cell_size = 50.0
+
+[time]
+dt = 120.0
+final_time = 480.0
+
+[remesh]
+hmax = 100.0
+
+[output]
+vtu_every = 0
+
+[ensemble]
+members = 5
+seed = 11
+[ensemble.ignition]
+polygon = [[250.0, 250.0], [950.0, 250.0], [950.0, 950.0], [250.0, 950.0]]
+radius = 150.0
+[ensemble.sample]
+"model.wind.speed" = {dist = "normal", mean = 3, sd = 1, min = 0}
+"model.wind.direction_deg" = {dist = "uniform", min = 200, max = 250}
+"model.R0" = {dist = "lognormal", mu = -0.92, sigma = 0.2}
+)";
+
+fs::path write_case(const TempDir& dir, const std::string& text = kCase) {
+  const fs::path file = dir / "case.toml";
+  std::ofstream(file) << text;
+  return file;
+}
+
+/// The files an ensemble's outputs are compared by: the reduced rasters, the table, the members'.
+std::vector<std::string> output_files(const fs::path& outdir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::recursive_directory_iterator(outdir))
+    if (entry.is_regular_file()) names.push_back(fs::relative(entry.path(), outdir).string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+void require_identical(const fs::path& a, const fs::path& b) {
+  const std::vector<std::string> files = output_files(a);
+  REQUIRE(files == output_files(b));
+  CHECK(std::find(files.begin(), files.end(), "burn_probability.asc") != files.end());
+  for (const std::string& name : files) {
+    INFO(name);
+    CHECK(read_file(a / name) == read_file(b / name));
+  }
+}
+
+struct Grid {
+  std::size_t cols = 0, rows = 0;
+  double nodata = -9999;
+  std::vector<double> values;
+};
+Grid read_grid(const fs::path& file) {
+  std::ifstream in(file);
+  Grid g;
+  std::string key;
+  double x0, y0, cell;
+  in >> key >> g.cols >> key >> g.rows >> key >> x0 >> key >> y0 >> key >> cell >> key >> g.nodata;
+  g.values.resize(g.cols * g.rows);
+  for (double& v : g.values) in >> v;
+  REQUIRE(in);
+  return g;
+}
+
+std::string ensemble(const fs::path& case_file, const fs::path& outdir, const std::string& extra = "") {
+  const auto result = run_bodyfit(fmt::format("--threads 1 ensemble {} -o {} {}", case_file.string(), outdir.string(), extra));
+  INFO(result.output);
+  REQUIRE(result.exit_code == 0);
+  return result.output;
+}
+
+}  // namespace
+
+TEST_CASE("a member's scenario is a function of its index alone") {
+  EnsembleSpec spec;
+  spec.seed = 11;
+  spec.parameters.push_back({.key = "model.R0", .distribution = SampledParameter::Distribution::LogNormal, .a = -0.9, .b = 0.2});
+  spec.parameters.push_back({.key = "model.wind.speed", .distribution = SampledParameter::Distribution::Normal, .a = 3, .b = 1, .min = 0});
+  IgnitionDomain domain;
+  domain.polygon = {{0, 0}, {100, 0}, {0, 100}};  // a triangle: some draws are rejected
+  domain.xmax = domain.ymax = 100;
+  domain.radius = 5;
+  std::vector<MemberScenario> forward;
+  for (std::size_t i = 0; i < 20; ++i) forward.push_back(sample_member(spec, domain, i));
+  for (std::size_t i = 20; i-- > 0;) {  // backwards, and with more members in the spec
+    spec.members = 1000;
+    const MemberScenario again = sample_member(spec, domain, i);
+    CHECK(again.overrides == forward[i].overrides);
+    CHECK(again.x == forward[i].x);
+    CHECK(again.y == forward[i].y);
+  }
+  for (const MemberScenario& s : forward) {
+    REQUIRE(s.ignition_found);
+    CHECK(s.x + s.y <= 100);  // inside the triangle
+    CHECK(s.values[0] > 0);   // lognormal
+    CHECK(s.values[1] >= 0);  // truncated normal
+  }
+  CHECK(forward[0].x != forward[1].x);
+  // Adding a parameter leaves the others' draws (each key has its own stream).
+  spec.parameters.insert(spec.parameters.begin(), SampledParameter{.key = "model.A", .distribution = SampledParameter::Distribution::Uniform, .a = 1, .b = 2});
+  const MemberScenario more = sample_member(spec, domain, 3);
+  CHECK(more.values[1] == forward[3].values[0]);
+  CHECK(more.values[2] == forward[3].values[1]);
+  CHECK(more.x == forward[3].x);
+  // Another seed, other draws.
+  spec.seed = 12;
+  CHECK(sample_member(spec, domain, 3).x != forward[3].x);
+}
+
+TEST_CASE("ensemble: probabilities are multiples of 1/N and the rasters reduce the members' arrival times") {
+  TempDir dir("ensemble_reduce");
+  const fs::path case_file = write_case(dir);
+  ensemble(case_file, dir / "out");
+  const Grid probability = read_grid(dir / "out/burn_probability.asc");
+  const Grid mean = read_grid(dir / "out/arrival_mean.asc");
+  const Grid p50 = read_grid(dir / "out/arrival_p50.asc");
+  const Grid p90 = read_grid(dir / "out/arrival_p90.asc");
+  std::vector<Grid> members;
+  for (int i = 0; i < 5; ++i) members.push_back(read_grid(dir / fmt::format("out/members/m{:06d}.asc", i)));
+  const std::size_t n = 5;
+  std::size_t some = 0;
+  for (std::size_t c = 0; c < probability.values.size(); ++c) {
+    const double p = probability.values[c];
+    REQUIRE(p >= 0);
+    REQUIRE(p <= 1);
+    const double k = std::round(p * double(n));
+    REQUIRE(p == k / double(n));
+    // The reduction of this cell, again from the members' rasters.
+    std::vector<double> times;
+    for (const Grid& m : members)
+      if (m.values[c] != m.nodata) times.push_back(m.values[c]);
+    REQUIRE(double(times.size()) == k);
+    if (times.empty()) {
+      CHECK(mean.values[c] == mean.nodata);
+      continue;
+    }
+    ++some;
+    double sum = 0;
+    for (double t : times) sum += t;
+    CHECK(mean.values[c] == sum / double(times.size()));
+    std::sort(times.begin(), times.end());
+    const double at = 0.5 * double(times.size() - 1);
+    const std::size_t lo = std::size_t(at);
+    const double median = times[lo] + (at - double(lo)) * (times[std::min(lo + 1, times.size() - 1)] - times[lo]);
+    CHECK(p50.values[c] == median);
+    CHECK(p90.values[c] >= p50.values[c]);
+    CHECK(p90.values[c] <= times.back());
+  }
+  CHECK(some > 0);
+  // The table: a row per member, all complete, with their sampled values.
+  std::ifstream table(dir / "out/members.csv");
+  std::string header;
+  std::getline(table, header);
+  CHECK(header ==
+        "index,status,ignition_x,ignition_y,model.R0,model.wind.direction_deg,model.wind.speed,burnt_area_m2,"
+        "final_time_s,iterations,stop,error");
+  int rows = 0;
+  for (std::string row; std::getline(table, row); ++rows) CHECK(row.starts_with(fmt::format("{},ok,", rows)));
+  CHECK(rows == 5);
+  CHECK(fs::exists(dir / "out/ros_mean.asc"));
+}
+
+TEST_CASE("ensemble: the same bytes sequentially, on 2 threads, and from the index alone") {
+  TempDir dir("ensemble_schedules");
+  const fs::path case_file = write_case(dir);
+  ensemble(case_file, dir / "sequential");
+  ensemble(case_file, dir / "threads", "--jobs 2");
+  require_identical(dir / "sequential", dir / "threads");
+  // Members 0-2 of a 3-member ensemble are those of the 5-member one.
+  ensemble(case_file, dir / "three", "--members 3");
+  for (int i = 0; i < 3; ++i)
+    for (const char* ext : {".asc", ".toml"}) {
+      const std::string name = fmt::format("members/m{:06d}{}", i, ext);
+      INFO(name);
+      CHECK(read_file(dir / "three" / name) == read_file(dir / "sequential" / name));
+    }
+}
+
+TEST_CASE("ensemble: a restart recomputes only the members whose results are missing") {
+  TempDir dir("ensemble_restart");
+  const fs::path case_file = write_case(dir);
+  ensemble(case_file, dir / "full");
+  fs::copy(dir / "full", dir / "restart", fs::copy_options::recursive);
+  for (int i : {1, 3}) {
+    fs::remove(dir / fmt::format("restart/members/m{:06d}.toml", i));
+    fs::remove(dir / fmt::format("restart/members/m{:06d}.asc", i));
+  }
+  fs::remove(dir / "restart/members/m000004.toml");  // a member killed before its record: it runs again
+  fs::remove(dir / "restart/burn_probability.asc");
+  const std::string log = ensemble(case_file, dir / "restart");
+  CHECK(log.find("2 members already complete, 3 to run") != std::string::npos);
+  CHECK(log.find("member 0:") == std::string::npos);
+  CHECK(log.find("member 1:") != std::string::npos);
+  require_identical(dir / "full", dir / "restart");
+  // Another case in that directory is refused.
+  const auto other = run_bodyfit(fmt::format("ensemble {} -o {} --seed 12", case_file.string(), (dir / "full").string()));
+  CHECK(other.exit_code == 1);
+  CHECK(other.output.find("holds an ensemble of another case") != std::string::npos);
+}
+
+TEST_CASE("ensemble: killed (SIGKILL) at any point, the same command completes it with the same bytes") {
+  TempDir dir("ensemble_killed");
+  const fs::path case_file = write_case(dir);
+  ensemble(case_file, dir / "full", "--members 8");
+  // Killed after 0.3, 0.6 and 0.9 s (wherever that lands: setting up, in a member, writing a
+  // record, reducing), each time continued by the same command until it completes.
+  for (const char* after : {"0.3", "0.6", "0.9"}) {
+    const std::string command = fmt::format("timeout -s KILL {} \"{}\" --threads 1 ensemble {} -o {} --members 8 > {} 2>&1",
+                                            after, BODYFIT_EXE, case_file.string(), (dir / "killed").string(),
+                                            (dir / "killed.log").string());
+    const int status = std::system(command.c_str());
+    INFO(read_file(dir / "killed.log"));
+    CHECK(status != -1);
+  }
+  ensemble(case_file, dir / "killed", "--members 8");
+  // The leftovers of killed members (their .work directories, temporaries) are gone.
+  for (const auto& entry : fs::directory_iterator(dir / "killed/members")) {
+    INFO(entry.path().string());
+    CHECK(entry.path().extension() != ".work");
+    CHECK(entry.path().filename().string().find(".tmp") == std::string::npos);
+  }
+  require_identical(dir / "full", dir / "killed");
+}
+
+TEST_CASE("ensemble: a failing member is recorded with its error and the others complete") {
+  TempDir dir("ensemble_failures");
+  // Ignitions over a box twice the terrain's: some disks miss the surface.
+  std::string text = kCase;
+  const std::string polygon = "polygon = [[250.0, 250.0], [950.0, 250.0], [950.0, 950.0], [250.0, 950.0]]";
+  text.replace(text.find(polygon), polygon.size(), "polygon = [[-1200.0, 0.0], [1200.0, 0.0], [1200.0, 1200.0], [-1200.0, 1200.0]]");
+  const fs::path case_file = write_case(dir, text);
+  const auto result = run_bodyfit(
+      fmt::format("--threads 1 ensemble {} -o {} --members 8 --inject-failure 2", case_file.string(), (dir / "out").string()));
+  INFO(result.output);
+  REQUIRE(result.exit_code == 0);
+  std::ifstream table(dir / "out/members.csv");
+  std::string row;
+  std::getline(table, row);
+  int ok = 0, outside = 0;
+  for (int i = 0; std::getline(table, row); ++i) {
+    INFO(row);
+    if (i == 2) {
+      CHECK(row.starts_with("2,failed,"));
+      CHECK(row.find("numerical error: injected failure") != std::string::npos);
+    } else if (row.find(",failed,") != std::string::npos) {
+      CHECK(row.find(",input error: ") != std::string::npos);  // the ignition disk missed the surface
+      CHECK((row.find("G(0) is empty") != std::string::npos || row.find("covers no face") != std::string::npos));
+      ++outside;
+    } else {
+      ++ok;
+    }
+  }
+  CHECK(outside > 0);
+  REQUIRE(ok > 0);
+  // The probability counts the completed members.
+  const Grid probability = read_grid(dir / "out/burn_probability.asc");
+  for (double p : probability.values) REQUIRE(p == std::round(p * ok) / ok);
+}
+
+TEST_CASE("ensemble: under MPI, 1 and 2 ranks give the sequential bytes") {
+  if constexpr (!config::have_mpi) {
+    MESSAGE("built without MPI: skipped");
+    return;
+  }
+#ifdef BODYFIT_MPIEXEC
+  TempDir dir("ensemble_mpi");
+  const fs::path case_file = write_case(dir);
+  ensemble(case_file, dir / "sequential");
+  for (int ranks : {1, 2}) {
+    const fs::path out = dir / fmt::format("np{}", ranks);
+    const std::string command = fmt::format(
+        "{} {} --oversubscribe -np {} \"{}\" --threads 1 ensemble {} -o {} > {} 2>&1", BODYFIT_MPIEXEC,
+        geteuid() == 0 ? "--allow-run-as-root" : "", ranks, BODYFIT_EXE, case_file.string(), out.string(),
+        (dir / fmt::format("np{}.log", ranks)).string());
+    const int status = std::system(command.c_str());
+    INFO(read_file(dir / fmt::format("np{}.log", ranks)));
+    REQUIRE(status == 0);
+    // Every rank joined the job (the log names the last one).
+    CHECK(read_file(dir / fmt::format("np{}.log", ranks)).find(fmt::format("[rank {}/{}]", ranks - 1, ranks)) !=
+          std::string::npos);
+    require_identical(dir / "sequential", out);
+  }
+#endif
+}
