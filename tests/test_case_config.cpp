@@ -401,7 +401,7 @@ hmax = 400.0
   CHECK(setup_case(parse(kValidCase)).options.remesh.feature_angle == 45);
 }
 
-TEST_CASE("balls: the Euclidean distance to the nearest sphere; bad balls are errors") {
+TEST_CASE("balls: the Euclidean distance to the nearest sphere, bad balls are errors") {
   const char* text = R"(
 [surface]
 generator = "sphere"

@@ -312,7 +312,7 @@ TEST_CASE("checkpoint writer: the snapshot is written in the background, one wri
   CHECK_THROWS_AS(nowhere.wait(), IoError);  // an output that cannot be written: exit code 6
 }
 
-TEST_CASE("bodyfit run: checkpoints at iterations N, 2N... and at the end; by seconds; only at the end") {
+TEST_CASE("bodyfit run: checkpoints at iterations N, 2N... and at the end, by seconds, only at the end") {
   PlaneRun plane;
   auto by_iterations = plane.run("every3", "--set time.iterations=7 --set output.checkpoint_every=3 "
                                            "--set output.checkpoint_seconds=0");

@@ -5,7 +5,7 @@
 
 using namespace bodyfit;
 
-TEST_CASE("parse_iso8601: exact seconds since the epoch, zones, fractions; refusals") {
+TEST_CASE("parse_iso8601: exact seconds since the epoch, zones, fractions, refusals") {
   CHECK(parse_iso8601("1970-01-01T00:00:00Z") == 0.0);
   CHECK(parse_iso8601("2000-03-01T00:00:00Z") == 951868800.0);  // after a leap day of a century leap year
   CHECK(parse_iso8601("2026-07-14T13:00:00Z") == 1784034000.0);
@@ -23,7 +23,7 @@ TEST_CASE("parse_iso8601: exact seconds since the epoch, zones, fractions; refus
   CHECK_FALSE(parse_iso8601(""));
 }
 
-TEST_CASE("format_iso8601: UTC to the second, milliseconds when needed; round trip") {
+TEST_CASE("format_iso8601: UTC to the second, milliseconds when needed, round trip") {
   CHECK(format_iso8601(0) == "1970-01-01T00:00:00Z");
   CHECK(format_iso8601(1784034000.0) == "2026-07-14T13:00:00Z");
   CHECK(format_iso8601(1784034000.0 + 86400 * 200 + 61.5) == "2027-01-30T13:01:01.500Z");

@@ -302,7 +302,7 @@ TEST_CASE("a fuel map's non-burnable cells stop the front") {
   CHECK(std::abs((500 - r0 - x_min) - free_run) / free_run < 0.02);  // the other side burns at R0
 }
 
-TEST_CASE("fuel NODATA and the codes of fuel.non_burnable stop the front; an unknown code is an error") {
+TEST_CASE("fuel NODATA and the codes of fuel.non_burnable stop the front, an unknown code is an error") {
   test::TempDir dir("fire_fuel_nodata");
   // 100 m cells over [0, 1200]²: NODATA (255, a byte raster's usual marker) for x ≥ 800, code 9
   // (water, listed in non_burnable) for x < 400, fuel 1 between.

@@ -309,7 +309,7 @@ TEST_CASE("dem: header variants: centre registration, any case, optional NODATA"
   CHECK(g.sample(10, 20) == 3);
 }
 
-TEST_CASE("dem: NODATA cells are read as they are; fill_nodata gives them the nearest valid height; all-NODATA is an error") {
+TEST_CASE("dem: NODATA cells are read as they are, fill_nodata gives them the nearest valid height, all-NODATA is an error") {
   bodyfit::test::TempDir dir("dem_nodata");
   write_text(dir / "n.asc",
              "ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9999\n"

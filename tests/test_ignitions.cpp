@@ -95,7 +95,7 @@ TEST_CASE("ignitions: a point, a line and a polygon with a hole give G(0) of the
   }
 }
 
-TEST_CASE("ignitions: points and lines need a radius; times need a start when they are date-times; CRS must match") {
+TEST_CASE("ignitions: points and lines need a radius, times need a start when they are date-times, CRS must match") {
   if constexpr (!config::have_gdal) return;
   test::TempDir dir("ignitions_errors");
   write_flat_dem(dir.path());

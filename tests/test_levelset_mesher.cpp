@@ -393,7 +393,7 @@ TEST_CASE("no crossing: one label everywhere, old interface tags removed, tags k
   }
 }
 
-TEST_CASE("split edges keep ridge, required and ref tags on both halves; orientation is kept") {
+TEST_CASE("split edges keep ridge, required and ref tags on both halves, orientation is kept") {
   SurfaceMesh mesh = make_square(8);
   // Tag the boundary edges and the line y = 0.5 as ridges, the line x = 0.25 as required.
   for (auto e : mesh.edges()) {
@@ -613,7 +613,7 @@ TEST_CASE("bodyfit discretize: cut (and remesh) from Medit files") {
   CHECK(!std::filesystem::exists(dir / "bad.mesh"));
 }
 
-TEST_CASE("bad level sets are input errors; deleted elements are collected") {
+TEST_CASE("bad level sets are input errors, deleted elements are collected") {
   SurfaceMesh mesh = make_sphere({.faces = 320});
   CHECK_THROWS_AS(discretize(mesh, ScalarField(mesh.n_vertices() - 1, 1.0)), InputError);
   ScalarField phi = sample(mesh, [](const Vec3& p) { return p[2]; });

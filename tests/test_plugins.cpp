@@ -173,7 +173,7 @@ TEST_CASE("bodyfit plugins lists names, versions, ABI, files, parameters and fai
   CHECK(contains(result.output, BODYFIT_TEST_PLUGIN_DIR));
 }
 
-TEST_CASE("conormal plugin: V = speed * conormal, tangential; unknown keys refused") {
+TEST_CASE("conormal plugin: V = speed * conormal, tangential, unknown keys refused") {
   LoadedModel model = load_model("conormal");
   CHECK(model->name() == "conormal");
   auto params = model->parameters();

@@ -104,7 +104,7 @@ TEST_CASE("write_raster: an ESRI ASCII grid with its .prj, NaN cells as NODATA")
     if (i != 3 && i != 11) CHECK(back.heights[i] == grid.heights[i]);
 }
 
-TEST_CASE("write_raster: an unknown extension or an empty grid is an InputError; an unwritable file an IoError") {
+TEST_CASE("write_raster: an unknown extension or an empty grid is an InputError, an unwritable file an IoError") {
   test::TempDir dir("raster_io_bad");
   const HeightGrid grid = sample_grid();
   CHECK_THROWS_AS(write_raster(dir / "a.png", grid), InputError);

@@ -313,7 +313,7 @@ TEST_CASE("collect_garbage gives the arrays of OpenMesh's garbage collection") {
   CHECK_MESSAGE(report.ok(), report.summary());
 }
 
-TEST_CASE("a generated sphere is left in its order; remesh() renumbers a scattered mesh, and with spatial_order = false only collects garbage") {
+TEST_CASE("a generated sphere is left in its order, remesh() renumbers a scattered mesh, and with spatial_order = false only collects garbage") {
   for (std::size_t faces : {5000, 60000}) {
     CAPTURE(faces);
     CHECK(spatial_disorder(make_sphere({.faces = faces})) < 0.1);

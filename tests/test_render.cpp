@@ -171,7 +171,7 @@ TEST_CASE("the top view is a map: x (east) to the right, y (north) up") {
   CHECK(!is_inside(50, 150));   // lower left: south-west
 }
 
-TEST_CASE("bodyfit plot: columns of a history to a PNG; an unknown column names the known ones") {
+TEST_CASE("bodyfit plot: columns of a history to a PNG, an unknown column names the known ones") {
   bodyfit::test::TempDir dir("plot_command");
   std::ofstream(dir / "history.csv") << "iteration,time,J\n0,0,nan\n1,0.1,2.5\n2,0.2,1.5\n3,0.3,1.25\n";
   auto ok = bodyfit::test::run_bodyfit("plot " + (dir / "history.csv").string() + " -y J -y time -o " +

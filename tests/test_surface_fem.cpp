@@ -45,7 +45,7 @@ double harmonic8(const Vec3& p) {
 
 }  // namespace
 
-TEST_CASE("mass matrix: entries sum to the area; lumped mass is its row sums") {
+TEST_CASE("mass matrix: entries sum to the area, lumped mass is its row sums") {
   SurfaceMesh square = flat_square(7);
   CHECK(sum_of_entries(mass_matrix(square)) == doctest::Approx(1.0).epsilon(1e-13));
 

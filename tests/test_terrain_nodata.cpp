@@ -165,7 +165,7 @@ TEST_CASE("terrain over NODATA: remeshed at the defaults, it keeps its loops, χ
   CHECK(off_data <= 0.5 * kCell);
 }
 
-TEST_CASE("terrain over NODATA: two separate blobs give two pieces; fill gives the whole rectangle") {
+TEST_CASE("terrain over NODATA: two separate blobs give two pieces, fill gives the whole rectangle") {
   auto two_blobs = [](long c, long s) { return s >= 2 && s < 14 && ((c >= 2 && c < 14) || (c >= 18 && c < 30)); };
   const HeightGrid g = masked_grid(32, 16, two_blobs);
   const SurfaceMesh mesh = make_terrain_from_grid(g);
@@ -207,7 +207,7 @@ TEST_CASE("terrain over NODATA: pieces touching at a corner are split, small isl
   CHECK_THROWS_AS(make_terrain_from_grid(g, GridTerrainOptions{.min_island_area = 1e9}), InputError);
 }
 
-TEST_CASE("terrain over NODATA: bodyfit mesh terrain says how many cells it left out; --nodata fill") {
+TEST_CASE("terrain over NODATA: bodyfit mesh terrain says how many cells it left out, --nodata fill") {
   test::TempDir dir("terrain_nodata_cli");
   HeightGrid g = masked_grid(40, 30, l_with_hole);
   write_esri_ascii(dir / "l.asc", g);

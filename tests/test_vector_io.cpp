@@ -53,7 +53,7 @@ double layer_feature_area(const VectorFeature& f) {
 
 }  // namespace
 
-TEST_CASE("region_outline: parts, a hole, parts touching at a point; outer CCW, holes CW, areas exact") {
+TEST_CASE("region_outline: parts, a hole, parts touching at a point, outer CCW, holes CW, areas exact") {
   const SurfaceMesh mesh = three_parts();
   std::vector<PlanPolygon> polygons = region_outline(mesh);
   REQUIRE(polygons.size() == 3);
@@ -117,7 +117,7 @@ TEST_CASE("write_polygon_layer: a GeoPackage and a GeoJSON read back by OGR with
   }
 }
 
-TEST_CASE("read_vector_layer: points, lines, polygons with holes and multi-parts from GeoJSON; errors name the file") {
+TEST_CASE("read_vector_layer: points, lines, polygons with holes and multi-parts from GeoJSON, errors name the file") {
   if constexpr (!config::have_gdal) return;
   test::TempDir dir("vector_io_read");
   const auto file = dir / "ignitions.geojson";
