@@ -5,6 +5,7 @@
 // leaves nothing); --resume with another case is refused unless --force.
 #include <bodyfit/case_identity.hpp>
 #include <bodyfit/checkpoint.hpp>
+#include <bodyfit/config.hpp>
 #include <bodyfit/run_directory.hpp>
 
 #include "test_support.hpp"
@@ -276,6 +277,24 @@ TEST_CASE("output directories: a previous run is refused unless --overwrite or -
   CHECK_FALSE(fs::exists(plane.dir / "out" / ".history.csv.tmp999-3"));
   CHECK(plane.checkpointed("out") == 2);
   CHECK(plane.run("out", "--overwrite --resume").exit_code == 2);  // one or the other
+
+  // The model's files too (VelocityModel::output_files): a fire run writing ESRI grids and GeoJSON
+  // perimeters (kFire) replaced by one writing GeoTIFFs and a GeoPackage leaves none of them.
+  if constexpr (config::have_gdal) {
+    Case fire("faults_dirs_fire", kFire);
+    REQUIRE(fire.run("out").exit_code == 0);
+    REQUIRE(fs::exists(fire.dir / "out" / "arrival_time.asc"));
+    REQUIRE(fs::exists(fire.dir / "out" / "perimeters.geojson"));
+    auto replaced = fire.run("out", "--overwrite --set model.arrival.format='\"tif\"' "
+                                    "--set model.perimeters.file='\"perimeters.gpkg\"'");
+    REQUIRE_MESSAGE(replaced.exit_code == 0, replaced.output);
+    CHECK(fs::exists(fire.dir / "out" / "arrival_time.tif"));
+    CHECK(fs::exists(fire.dir / "out" / "perimeters.gpkg"));
+    for (const char* gone : {"arrival_time.asc", "arrival_time.prj", "rate_of_spread.asc", "perimeters.geojson"}) {
+      CAPTURE(gone);
+      CHECK_FALSE(fs::exists(fire.dir / "out" / gone));
+    }
+  }
 
   // A failed set-up writes nothing: a bad key, an unknown model, a bad mesh, a failing configure.
   std::ofstream(plane.dir / "bad.mesh") << "not a mesh at all\n";

@@ -133,13 +133,14 @@ void check_same_case(const Checkpoint& c, const std::string& case_text, bool for
 }
 
 /// The output directory, ready to be written: created; with --overwrite the previous run's files
-/// removed; the temporaries of killed writes removed; on --resume the per-state files past the
+/// (the driver's and the model's) removed; the temporaries of killed writes removed; on --resume the per-state files past the
 /// checkpoint removed (the resumed run writes again those it should).
-void prepare_directory(const fs::path& outdir, const RunArguments& args, int resumed_iteration) {
+void prepare_directory(const fs::path& outdir, const RunArguments& args, int resumed_iteration,
+                       const std::vector<std::string>& model_files) {
   std::error_code ec;
   fs::create_directories(outdir, ec);
   if (ec) throw IoError(fmt::format("{}: cannot create the output directory ({})", outdir.string(), ec.message()));
-  if (args.overwrite) remove_run_outputs(outdir);
+  if (args.overwrite) remove_run_outputs(outdir, model_files);
   if (const std::size_t n = remove_stale_temporaries(outdir))
     spdlog::info("{}: removed {} temporary files of interrupted writes", outdir.string(), n);
   if (resumed_iteration >= 0) remove_states_from(outdir, resumed_iteration);
@@ -357,7 +358,10 @@ int run_case(const RunArguments& args) {
 
   // From here on the directory is written.
   set_fault_iteration(start.iteration);
-  prepare_directory(outdir, args, resumed ? start.iteration : -1);
+  // A model built against ABI < 2.3 has no output_files() in its vtable.
+  const std::vector<std::string> model_files =
+      (model.abi() & 0xffffu) >= 3 ? model->output_files() : std::vector<std::string>();
+  prepare_directory(outdir, args, resumed ? start.iteration : -1, model_files);
   RunOutputs outputs(config, outdir, guarded, case_text, inject);
   if (resumed) {
     mesh = std::move(resumed->mesh);

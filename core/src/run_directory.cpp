@@ -58,7 +58,11 @@ std::vector<fs::path> run_outputs(const fs::path& dir) {
   return files;
 }
 
-void remove_run_outputs(const fs::path& dir) { remove_files(dir, is_run_output); }
+void remove_run_outputs(const fs::path& dir, const std::vector<std::string>& model_files) {
+  remove_files(dir, [&](const std::string& name) {
+    return is_run_output(name) || std::find(model_files.begin(), model_files.end(), name) != model_files.end();
+  });
+}
 
 std::size_t remove_stale_temporaries(const fs::path& dir) { return remove_files(dir, is_atomic_temporary); }
 

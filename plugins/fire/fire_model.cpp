@@ -377,6 +377,15 @@ class FireModel final : public VelocityModel {
     }
   }
 
+  std::vector<std::string> output_files() const override {
+    std::vector<std::string> files = {"arrival_time.tif", "arrival_time.asc", "arrival_time.prj",
+                                      "rate_of_spread.tif", "rate_of_spread.asc", "rate_of_spread.prj",
+                                      "perimeters.gpkg",  "perimeters.geojson", "fire_map.png"};
+    if (!perimeter_file_.empty() && std::find(files.begin(), files.end(), perimeter_file_) == files.end())
+      files.push_back(perimeter_file_);
+    return files;
+  }
+
  private:
   // The state's outline, once per iteration (sub-steps and retried steps compute on the same
   // state); kept when it is a perimeters.every-th state, and always as the latest (the final state

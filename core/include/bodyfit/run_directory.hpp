@@ -16,8 +16,9 @@ namespace bodyfit {
 bool is_run_output(const std::string& file_name);
 /// The run's own files in `dir` (sorted; empty when `dir` does not exist).
 std::vector<std::filesystem::path> run_outputs(const std::filesystem::path& dir);
-/// Remove them (--overwrite); other files and subdirectories stay. Throws IoError on a failure.
-void remove_run_outputs(const std::filesystem::path& dir);
+/// Remove them (--overwrite), and the files of `model_files` (VelocityModel::output_files); other
+/// files and subdirectories stay. Throws IoError on a failure.
+void remove_run_outputs(const std::filesystem::path& dir, const std::vector<std::string>& model_files = {});
 /// Remove the temporaries left by writes of a killed process. Returns how many there were.
 std::size_t remove_stale_temporaries(const std::filesystem::path& dir);
 /// Remove the per-state files (step_<n>.vtu, snap_<n>.png) of states n ≥ `first`: on --resume

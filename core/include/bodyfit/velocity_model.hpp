@@ -34,7 +34,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 2;
+inline constexpr std::uint32_t kPluginAbiMinor = 3;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// One parameter a model accepts, for `bodyfit plugins` and for error messages.
@@ -217,6 +217,10 @@ class VelocityModel {
   virtual void load_state(const ModelState& /*state*/) {}
   /// Called once when the run ends (after the last state); may write files to output_dir.
   virtual void finish(const std::filesystem::path& /*output_dir*/) {}
+  /// (ABI 2.3) The names of the files the model may write in the output directory, whatever its
+  /// settings (both formats of a raster, its default names): `bodyfit run --overwrite` removes
+  /// them with the driver's own, so a replaced run leaves none of the previous run's files.
+  virtual std::vector<std::string> output_files() const { return {}; }
 };
 
 }  // namespace bodyfit
