@@ -319,8 +319,12 @@ TEST_CASE("ensemble: under MPI, 1 and 2 ranks give the sequential bytes") {
   ensemble(case_file, dir / "sequential");
   for (int ranks : {1, 2}) {
     const fs::path out = dir / fmt::format("np{}", ranks);
+    // Open MPI leaks by design at MPI_Finalize, in components it loads and unloads itself (no
+    // stack to suppress): under the sanitize stage, leak detection is off for these ranks only.
     const std::string command = fmt::format(
-        "{} {} --oversubscribe -np {} \"{}\" --threads 1 ensemble {} -o {} > {} 2>&1", BODYFIT_MPIEXEC,
+        "ASAN_OPTIONS=\"${{ASAN_OPTIONS:-}}:detect_leaks=0\" {} {} --oversubscribe -np {} \"{}\" --threads 1 "
+        "ensemble {} -o {} > {} 2>&1",
+        BODYFIT_MPIEXEC,
         geteuid() == 0 ? "--allow-run-as-root" : "", ranks, BODYFIT_EXE, case_file.string(), out.string(),
         (dir / fmt::format("np{}.log", ranks)).string());
     const int status = std::system(command.c_str());

@@ -19,6 +19,18 @@
 
 using namespace bodyfit;
 
+// Whether AddressSanitizer instruments this build (gcc says __SANITIZE_ADDRESS__, clang __has_feature).
+#if defined(__SANITIZE_ADDRESS__)
+#define BODYFIT_TEST_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define BODYFIT_TEST_UNDER_ASAN 1
+#endif
+#endif
+#ifndef BODYFIT_TEST_UNDER_ASAN
+#define BODYFIT_TEST_UNDER_ASAN 0
+#endif
+
 TEST_CASE("soak: the exact |G(0)| is the area of the union of the two caps") {
   // Independently of the bench's quadrature: cap 0, plus the rings about axis 0 outside it, each
   // counted for the part of it inside cap 1 (a closed form in the azimuth about axis 0).
@@ -95,5 +107,9 @@ TEST_CASE("soak (short): two caps split and merge for 400 iterations, area, qual
   CHECK(double(faces_min) >= double(faces_start) - 4 * longest_front / c.h);
   // A leak of one mesh per iteration (~3,000 faces, several hundred kB with OpenMesh's
   // connectivity) over the 320 iterations after the first period would exceed 8 MiB many times.
+  // (Not under AddressSanitizer, whose quarantine holds freed blocks back by design: its RSS grows
+  // by up to its quarantine size with no leak. LeakSanitizer checks leaks there instead.)
+#if !BODYFIT_TEST_UNDER_ASAN
   CHECK(rss_max < rss_after_first_period + 8);
+#endif
 }
