@@ -121,6 +121,20 @@ void check_declared_counts(std::string_view bytes, const std::string& ext, const
       if (name == "face") counts[1] = n;
     }
     fits(counts[0], counts[1], 3, 4);  // the smallest binary records
+    // OpenMesh's header reader gives a property to the last element declared, and crashes when
+    // there is none yet (fuzz_openmesh: tests/fuzz/regressions/openmesh-ply-property-before-element).
+    bool element_seen = false;
+    long line_number = 0;
+    for (std::size_t at = 0; at < end;) {
+      const std::size_t line_end = std::min(bytes.find('\n', at), end);
+      std::size_t word_at = at;
+      const std::string_view first = next_word(bytes.substr(0, line_end), word_at);
+      ++line_number;
+      if (first == "element") element_seen = true;
+      if (first == "property" && !element_seen)
+        throw file_error(file, line_number, "a 'property' before any 'element' in the PLY header");
+      at = line_end + 1;
+    }
   }
 }
 
