@@ -4,22 +4,26 @@
 # exception other than InputError or an input slower than --timeout fails the run; the input is
 # saved in the output directory (artifact_prefix) and named in the message. New corpus entries go
 # to the output directory, never into the source tree.
-#   usage: scripts/run_fuzzers.sh [--build DIR] [--seconds S] [--timeout S] [--out DIR] [target...]
+#   usage: scripts/run_fuzzers.sh [--build DIR] [--seconds S] [--timeout S] [--seed N] [--out DIR] [target...]
 #   --build    the build directory with bin/fuzz_* (default build-sanitize/)
 #   --seconds  per target (default 30)
 #   --timeout  per input (default 5)
+#   --seed     libFuzzer's random seed (default 1: CI explores the same inputs every run, so a
+#              finding is one the change under test brought; 0 picks one at random, to explore)
 #   --out      working directory (default <build>/fuzz-run)
 #   targets    default: all (mesh_text mesh_binary sol openmesh esri_grid case checkpoint)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-build="${BODYFIT_SANITIZE_BUILD_DIR:-$ROOT/build-sanitize}" seconds=30 timeout=5 out="" targets=()
+build="${BODYFIT_SANITIZE_BUILD_DIR:-$ROOT/build-sanitize}" seconds=30 timeout=5 seed=1 out="" targets=()
 while (($#)); do
   case "$1" in
-    --build|--seconds|--timeout|--out)
+    --build|--seconds|--timeout|--seed|--out)
       (($# >= 2)) || { echo "run_fuzzers.sh: $1 needs a value" >&2; exit 2; }
-      case "$1" in --build) build=$2 ;; --seconds) seconds=$2 ;; --timeout) timeout=$2 ;; --out) out=$2 ;; esac
+      case "$1" in
+        --build) build=$2 ;; --seconds) seconds=$2 ;; --timeout) timeout=$2 ;; --seed) seed=$2 ;; --out) out=$2 ;;
+      esac
       shift ;;
-    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "run_fuzzers.sh: unknown option '$1'" >&2; exit 2 ;;
     *) targets+=("$1") ;;
   esac
@@ -41,7 +45,7 @@ for t in "${targets[@]}"; do
   corpus="$out/$t/corpus" log="$out/$t/log.txt"
   mkdir -p "$corpus" "$out/$t/artifacts"
   code=0
-  "$exe" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -print_final_stats=1 \
+  "$exe" -seed="$seed" -max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$out/$t/artifacts/" "$corpus" "$ROOT/tests/fuzz/$t" > "$log" 2>&1 || code=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n 1)
