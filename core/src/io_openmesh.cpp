@@ -121,19 +121,36 @@ void check_declared_counts(std::string_view bytes, const std::string& ext, const
       if (name == "face") counts[1] = n;
     }
     fits(counts[0], counts[1], 3, 4);  // the smallest binary records
-    // OpenMesh's header reader gives a property to the last element declared, and crashes when
-    // there is none yet (fuzz_openmesh: tests/fuzz/regressions/openmesh-ply-property-before-element).
+    // The header's grammar, before OpenMesh reads it: its reader crashed on a property before any
+    // element and looped on a misspelt line (fuzz_openmesh: tests/fuzz/regressions/openmesh-ply-*).
+    // "ply", "format <ascii|binary_little_endian|binary_big_endian> 1.0", then comment, obj_info,
+    // element <name> <count> and property lines (a property after an element) up to end_header.
     bool element_seen = false;
     long line_number = 0;
     for (std::size_t at = 0; at < end;) {
       const std::size_t line_end = std::min(bytes.find('\n', at), end);
-      std::size_t word_at = at;
-      const std::string_view first = next_word(bytes.substr(0, line_end), word_at);
-      ++line_number;
-      if (first == "element") element_seen = true;
-      if (first == "property" && !element_seen)
-        throw file_error(file, line_number, "a 'property' before any 'element' in the PLY header");
+      std::string_view line = bytes.substr(at, line_end - at);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       at = line_end + 1;
+      ++line_number;
+      std::size_t word_at = 0;
+      const std::string_view first = next_word(line, word_at);
+      auto fail = [&](const std::string& what) { throw file_error(file, line_number, "PLY header: " + what); };
+      if (line_number == 1) {
+        if (line != "ply") fail("the first line must be 'ply'");
+      } else if (line_number == 2) {
+        const std::string_view format = next_word(line, word_at);
+        if (first != "format" || (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") ||
+            next_word(line, word_at) != "1.0")
+          fail("the second line must be 'format ascii|binary_little_endian|binary_big_endian 1.0'");
+      } else if (first == "element") {
+        element_seen = true;
+      } else if (first == "property") {
+        if (!element_seen) fail("a 'property' before any 'element'");
+      } else if (first != "comment" && first != "obj_info" && !first.empty()) {
+        fail(fmt::format("'{}' is not a header keyword (element, property, comment, obj_info, end_header)",
+                         first.substr(0, 40)));
+      }
     }
   }
 }
