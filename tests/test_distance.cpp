@@ -527,3 +527,77 @@ TEST_CASE("DistanceSolver::redistance: the whole-mesh signed distance within the
     CHECK(band.size() < mesh.n_vertices() / 2);  // a band, not the mesh
   }
 }
+
+namespace {
+/// Where φ's P1 zero set crosses each edge whose ends have opposite signs (edge index → fraction
+/// from its first vertex): the zero set, as the cut will see it.
+std::vector<std::pair<int, double>> crossings(const SurfaceMesh& mesh, const ScalarField& phi) {
+  std::vector<std::pair<int, double>> out;
+  for (auto e : mesh.edges()) {
+    const auto h = mesh.halfedge_handle(e, 0);
+    const double a = phi[mesh.from_vertex_handle(h).idx()], b = phi[mesh.to_vertex_handle(h).idx()];
+    if (a * b < 0) out.emplace_back(e.idx(), a / (a - b));
+  }
+  return out;
+}
+
+double largest_shift(const std::vector<std::pair<int, double>>& x, const std::vector<std::pair<int, double>>& y) {
+  if (x.size() != y.size()) return std::numeric_limits<double>::infinity();  // edges gained or lost
+  double worst = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (x[i].first != y[i].first) return std::numeric_limits<double>::infinity();
+    worst = std::max(worst, std::abs(x[i].second - y[i].second));
+  }
+  return worst;
+}
+}  // namespace
+
+TEST_CASE("keep_crossings: redistancing leaves the zero set where it was, the far field as without it") {
+  const SurfaceMesh mesh = make_sphere({.faces = 9680});
+  const double h = edge_length_stats(mesh).mean;
+  // A curved zero set and a φ that is not a distance: the exact initialisation re-places the
+  // crossings by O(h²κ) (what CFL sub-steps used to add up), keep_crossings must not move them.
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    phi[v.idx()] = 3 * (p[2] - 0.2 + 0.1 * std::sin(5 * std::atan2(p[1], p[0])));
+  }
+  const auto before = crossings(mesh, phi);
+  REQUIRE(before.size() > 50);
+  DistanceOptions keep;
+  keep.keep_crossings = true;
+  const ScalarField moved = signed_distance(mesh, phi), kept = signed_distance(mesh, phi, keep);
+  // Without it the zero set moves (so this test can tell), with it not at all.
+  CHECK(largest_shift(before, crossings(mesh, moved)) > 1e-3);
+  CHECK(largest_shift(before, crossings(mesh, kept)) == 0.0);
+  // Only the vertices of crossed faces keep φ; every other vertex has the distance.
+  std::vector<char> on_crossed_face(mesh.n_vertices(), 0);
+  for (auto f : mesh.faces()) {
+    double lo = 1e300, hi = -1e300;
+    for (auto v : mesh.fv_range(f)) lo = std::min(lo, phi[v.idx()]), hi = std::max(hi, phi[v.idx()]);
+    if (lo < 0 && hi > 0)
+      for (auto v : mesh.fv_range(f)) on_crossed_face[v.idx()] = 1;
+  }
+  std::size_t kept_count = 0, differ = 0;
+  for (auto v : mesh.vertices()) {
+    const int i = v.idx();
+    if (on_crossed_face[i]) kept_count += kept[i] == phi[i];
+    else differ += kept[i] != moved[i];
+  }
+  CHECK(kept_count == std::size_t(std::count(on_crossed_face.begin(), on_crossed_face.end(), 1)));
+  CHECK(differ == 0);
+
+  // The band version, called again and again as the sub-steps do: the crossings never move, while
+  // re-placing them drifts further with every call.
+  std::vector<int> near;
+  for (auto v : mesh.vertices())
+    if (std::abs(moved[v.idx()]) <= 2 * h) near.push_back(v.idx());
+  DistanceSolver solver(mesh);
+  ScalarField band_kept = phi, band_moved = phi;
+  for (int call = 0; call < 5; ++call) {
+    solver.redistance(band_kept, 6 * h, near, nullptr, keep);
+    solver.redistance(band_moved, 6 * h, near);
+  }
+  CHECK(largest_shift(before, crossings(mesh, band_kept)) == 0.0);
+  CHECK(largest_shift(before, crossings(mesh, band_moved)) > 1e-3);
+}

@@ -214,6 +214,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.final_time = config.time.final_time;
   options.max_cfl = config.time.max_cfl;
   options.narrow_band = config.time.narrow_band;
+  options.keep_crossings = config.time.keep_crossings;
   options.max_substeps = config.time.max_substeps;
   options.max_rejections = config.time.max_rejections;
   options.cfl_length = setup.h;

@@ -706,6 +706,15 @@ ScalarField signed_result(const Seeds& seeds, const MarchWorkspace& w, double ba
   return result;
 }
 
+/// DistanceOptions::keep_crossings: the vertices of the seed faces take back their values of φ.
+void keep_crossing_values(const FlatMesh& m, const Seeds& seeds, const ScalarField& phi, ScalarField& d) {
+  for (int f : seeds.faces)
+    for (int c = 0; c < 3; ++c) {
+      const int v = m.corner_vertex[3 * f + c];
+      d[v] = phi[v];
+    }
+}
+
 double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
@@ -736,8 +745,10 @@ struct DistanceSolver::Impl {
   std::vector<std::uint32_t> face_seen;  ///< redistance: = epoch for the faces searched in this call
   std::uint32_t epoch = 0;
 
+  /// φ: the level set of φ mode (null in region mode), for DistanceOptions::keep_crossings.
   template <class MakeSeeds>
-  ScalarField run(const DistanceOptions& options, DistanceReport* report, MakeSeeds make_seeds) {
+  ScalarField run(const DistanceOptions& options, DistanceReport* report, MakeSeeds make_seeds,
+                  const ScalarField* phi = nullptr) {
     DistanceReport local;
     local.setup_ms = std::exchange(setup_ms, 0.0);  // charged to the first call only
     auto start = std::chrono::steady_clock::now();
@@ -746,6 +757,7 @@ struct DistanceSolver::Impl {
     start = std::chrono::steady_clock::now();
     march(flat, seeds, options, workspace, local);
     ScalarField d = signed_result(seeds, workspace, options.narrow_band);
+    if (phi && options.keep_crossings) keep_crossing_values(flat, seeds, *phi, d);
     local.march_ms = milliseconds_since(start);
     if (report) *report = local;
     return d;
@@ -763,7 +775,7 @@ DistanceSolver::DistanceSolver(DistanceSolver&&) noexcept = default;
 ScalarField DistanceSolver::signed_distance(const ScalarField& phi, const DistanceOptions& options,
                                             DistanceReport* report) {
   check_level_set(impl_->mesh, phi);
-  return impl_->run(options, report, [&](const FlatMesh& m) { return seeds_from_phi(m, phi); });
+  return impl_->run(options, report, [&](const FlatMesh& m) { return seeds_from_phi(m, phi); }, &phi);
 }
 
 ScalarField DistanceSolver::signed_distance_to_region(const DistanceOptions& options, DistanceReport* report) {
@@ -773,7 +785,7 @@ ScalarField DistanceSolver::signed_distance_to_region(const DistanceOptions& opt
 }
 
 std::vector<int> DistanceSolver::redistance(ScalarField& phi, double width, std::span<const int> near,
-                                            DistanceReport* report) {
+                                            DistanceReport* report, const DistanceOptions& keep) {
   Impl& s = *impl_;
   const FlatMesh& m = s.flat;
   if (phi.size() != m.nv) check_level_set(s.mesh, phi);
@@ -804,7 +816,14 @@ std::vector<int> DistanceSolver::redistance(ScalarField& phi, double width, std:
   for (int v : s.workspace.touched)
     if (s.workspace.state[v] == 3 && s.workspace.dist[v] <= width) band.push_back(v);
   std::sort(band.begin(), band.end());
+  // keep_crossings: the seed faces' vertices take back φ, which leaves the zero set in place and
+  // the far field as marched from it.
+  std::vector<std::pair<int, double>> kept;
+  if (keep.keep_crossings)
+    for (int f : seeds.faces)
+      for (int c = 0; c < 3; ++c) kept.emplace_back(m.corner_vertex[3 * f + c], phi[m.corner_vertex[3 * f + c]]);
   for (int v : band) phi[v] = phi[v] > 0 ? s.workspace.dist[v] : phi[v] < 0 ? -s.workspace.dist[v] : 0.0;
+  for (const auto& [v, value] : kept) phi[v] = value;
   local.march_ms = milliseconds_since(start);
   if (report) *report = local;
   return band;

@@ -206,6 +206,8 @@ class Evolution {
     LevelSetStep step;
     Stopwatch clock;
     const bool in_band = options_.narrow_band;
+    DistanceOptions redistancing = options_.distance;
+    redistancing.keep_crossings = options_.keep_crossings;
     if (!solver_) solver_.emplace(mesh_);
     DistanceSolver& solver = *solver_;  // T^n's flat arrays, for every sub-step
     Advector advector(mesh_);
@@ -225,14 +227,14 @@ class Evolution {
       const double remaining = dt - step.done;
       if (step.substeps > 0) {  // φ: the advected one, redistanced around its zero set
         if (in_band) {
-          std::vector<int> moved = solver.redistance(phi, width, traced);
+          std::vector<int> moved = solver.redistance(phi, width, traced, nullptr, redistancing);
           // Leaving the band: |φ| ≥ width with its sign, so that φ stays a distance clamped there.
           for (int v : band)
             if (!std::binary_search(moved.begin(), moved.end(), v)) phi[v] = next[v] = std::copysign(width, phi[v]);
           for (int v : moved) next[v] = phi[v];
           band = std::move(moved);
         } else {
-          phi = solver.signed_distance(phi, options_.distance);
+          phi = solver.signed_distance(phi, redistancing);
           band = within(phi, width);
         }
         step.ms.distance += clock.lap_ms();

@@ -25,6 +25,13 @@ struct DistanceOptions {
   /// O(h²κ) wherever the front is curved, which adds up to a first-order error far from the
   /// interface.
   bool front_curvature = true;
+  /// φ mode: the vertices of the faces the zero set crosses keep their values of φ; only the
+  /// vertices beyond get the distance. The exact initialisation gives those vertices the distance to
+  /// the P1 zero set, whose own P1 zero set lies O(h²κ) elsewhere: redistancing once is harmless,
+  /// but the CFL sub-steps of a step redistance tens of times, and on a front that moves slowly
+  /// (a fire's flanks) the shifts add up to more than the motion (docs/fire.md, "Sub-steps").
+  /// With it, redistancing leaves the zero set exactly where it was.
+  bool keep_crossings = false;
 };
 
 struct DistanceReport {
@@ -63,9 +70,10 @@ class DistanceSolver {
   /// Narrow-band redistancing in place: φ becomes its signed distance (φ-mode, as signed_distance)
   /// at the vertices within `width` of its zero set, which are returned (sorted); every other
   /// value is left as it is. The zero set is looked for in the faces around the vertices `near`,
-  /// which must include every vertex of a face where φ changes sign.
+  /// which must include every vertex of a face where φ changes sign. Of `options`, only
+  /// keep_crossings applies.
   std::vector<int> redistance(ScalarField& phi, double width, std::span<const int> near,
-                              DistanceReport* report = nullptr);
+                              DistanceReport* report = nullptr, const DistanceOptions& options = {});
 
  private:
   struct Impl;

@@ -100,6 +100,11 @@ struct EvolutionOptions {
   /// vertices beyond keep their sign). A sub-step then costs what the band holds, not the mesh.
   /// false: every stage on the whole surface (the reference the band is tested against).
   bool narrow_band = true;
+  /// With max_cfl: the sub-steps' redistancing keeps φ at the vertices of the faces its zero set
+  /// crosses (DistanceOptions::keep_crossings), so that only the advection moves the front. false:
+  /// those vertices get the distance to the P1 zero set each sub-step, which shifts the front by
+  /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/fire.md).
+  bool keep_crossings = true;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   /// CFL sub-steps one step may take (0: no limit): a Δt far beyond what the speeds allow is an
   /// InputError at the step that needs more, naming the count, not a run that never ends.
