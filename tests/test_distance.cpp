@@ -20,6 +20,16 @@ using namespace bodyfit;
 
 namespace {
 
+/// Not a distance: 3·(z − 0.2 + 0.1 sin 5θ), whose zero set is a wobbly curve round the sphere.
+ScalarField wavy_level_set(const SurfaceMesh& mesh) {
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    phi[v.idx()] = 3 * (p[2] - 0.2 + 0.1 * std::sin(5 * std::atan2(p[1], p[0])));
+  }
+  return phi;
+}
+
 constexpr double kCap = std::numbers::pi / 4;
 
 double polar_angle(const Vec3& p) { return std::acos(std::clamp(p[2] / p.norm(), -1.0, 1.0)); }
@@ -496,11 +506,7 @@ TEST_CASE("DistanceSolver::redistance: the whole-mesh signed distance within the
   const SurfaceMesh mesh = make_sphere({.faces = 9680});
   const double h = edge_length_stats(mesh).mean;
   // Not a distance: a wavy, scaled level set whose zero set is a wobbly curve round the sphere.
-  ScalarField phi(mesh.n_vertices());
-  for (auto v : mesh.vertices()) {
-    const Vec3& p = mesh.point(v);
-    phi[v.idx()] = 3 * (p[2] - 0.2 + 0.1 * std::sin(5 * std::atan2(p[1], p[0])));
-  }
+  const ScalarField phi = wavy_level_set(mesh);
   const ScalarField exact = signed_distance(mesh, phi);
   const double width = 6 * h;
   // `near`: a superset of the vertices of the faces where φ changes sign.
@@ -557,11 +563,7 @@ TEST_CASE("keep_crossings: redistancing leaves the zero set where it was, the fa
   const double h = edge_length_stats(mesh).mean;
   // A curved zero set and a φ that is not a distance: the exact initialisation re-places the
   // crossings by O(h²κ) (what CFL sub-steps used to add up), keep_crossings must not move them.
-  ScalarField phi(mesh.n_vertices());
-  for (auto v : mesh.vertices()) {
-    const Vec3& p = mesh.point(v);
-    phi[v.idx()] = 3 * (p[2] - 0.2 + 0.1 * std::sin(5 * std::atan2(p[1], p[0])));
-  }
+  const ScalarField phi = wavy_level_set(mesh);
   const auto before = crossings(mesh, phi);
   REQUIRE(before.size() > 50);
   DistanceOptions keep;

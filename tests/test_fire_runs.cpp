@@ -93,6 +93,18 @@ double distance_to_segments(const Vec3& p, const Segments& segments) {
   return nearest;
 }
 
+// 1.4 km square of hills and hollows (heights ±amplitude, wavelengths 1.1 and 1.4 km), cells of h.
+HeightGrid bumpy_ground(double h, double amplitude) {
+  HeightGrid grid;
+  grid.cell_size = h;
+  grid.cols = grid.rows = std::size_t(1400 / h) + 1;
+  grid.heights.resize(grid.cols * grid.rows);
+  for (std::size_t r = 0; r < grid.rows; ++r)
+    for (std::size_t c = 0; c < grid.cols; ++c)
+      grid.heights[r * grid.cols + c] = amplitude * std::sin(double(c) * h / 170) * std::cos(double(r) * h / 230);
+  return grid;
+}
+
 // An ESRI ASCII grid read as written, NODATA values included.
 HeightGrid read_raw_grid(const std::filesystem::path& file) {
   std::ifstream in(file);
@@ -197,14 +209,8 @@ TEST_CASE("many sub-steps: the slow back still runs at R0 (redistancing keeps th
 
 TEST_CASE("narrow-band sub-steps: the whole-surface computation's front and arrival times") {
   // Bumpy ground and a wind: R varies along the front and the sub-steps recompute it near the front.
-  const double h = 20, size = 1400;
-  HeightGrid grid;
-  grid.cell_size = h;
-  grid.cols = grid.rows = std::size_t(size / h) + 1;
-  grid.heights.resize(grid.cols * grid.rows);
-  for (std::size_t r = 0; r < grid.rows; ++r)
-    for (std::size_t c = 0; c < grid.cols; ++c)
-      grid.heights[r * grid.cols + c] = 60 * std::sin(double(c) * h / 170) * std::cos(double(r) * h / 230);
+  const double h = 20;
+  const HeightGrid grid = bumpy_ground(h, 60);
   const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n[arrival]\nformat = 'asc'\n";
   test::TempDir dir_band("fire_band"), dir_whole("fire_whole");
   FireRun band = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 120, 3, dir_band.path(), 0.05, 1.0);
@@ -237,14 +243,8 @@ TEST_CASE("CFL sub-steps converge: max_cfl 4 and max_cfl 1 give the same front")
   // R0 on the flanks to many times it uphill. Redistancing re-placed the zero set by O(h^2 kappa)
   // every sub-step, which added up with their number (EvolutionOptions::keep_crossings): max_cfl 4
   // and 1 then burnt areas 13 % apart on the four-fire case (docs/fire.md, "Sub-steps").
-  const double h = 20, size = 1400;
-  HeightGrid grid;
-  grid.cell_size = h;
-  grid.cols = grid.rows = std::size_t(size / h) + 1;
-  grid.heights.resize(grid.cols * grid.rows);
-  for (std::size_t r = 0; r < grid.rows; ++r)
-    for (std::size_t c = 0; c < grid.cols; ++c)
-      grid.heights[r * grid.cols + c] = 200 * std::sin(double(c) * h / 170) * std::cos(double(r) * h / 230);
+  const double h = 20;
+  const HeightGrid grid = bumpy_ground(h, 200);
   const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
   auto run = [&](double max_cfl) {
     return burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 200, 2, {}, 0.05, max_cfl);
