@@ -45,7 +45,15 @@ double peak_memory_mib() {
 /// The MPI job when asked (--mpi) or when a launcher started us, else this process alone.
 ProcessGroup process_group(bool mpi) {
   if (mpi) return ProcessGroup::join_mpi();
-  if (!started_by_mpi_launcher()) return ProcessGroup();
+  const LaunchEnvironment launch = read_launch_environment();
+  if (launch.launcher == LaunchEnvironment::Launcher::none) {
+    if (launch.allocation_tasks > 1)
+      spdlog::warn("this SLURM allocation has {} tasks, but bodyfit was not started by srun: this one process runs "
+                   "every member, on its own threads (--jobs); start it with `srun bodyfit ensemble ...` to spread "
+                   "the members over the tasks",
+                   launch.allocation_tasks);
+    return ProcessGroup();
+  }
   if constexpr (!config::have_mpi) {
     spdlog::warn("started by an MPI launcher, but this bodyfit was built without MPI: each process runs the whole "
                  "ensemble alone");
