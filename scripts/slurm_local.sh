@@ -87,8 +87,7 @@ start_munge() {
 }
 
 wait_for_node() {
-  local i
-  for i in $(seq 1 60); do
+  for _ in $(seq 1 60); do
     if sinfo -h -o '%T' 2>/dev/null | grep -Eq '^(idle|mixed|allocated)'; then return 0; fi
     sleep 0.5
   done
@@ -141,6 +140,6 @@ case ${1:-} in
   start) start ;;
   stop) stop ;;
   status) status ;;
-  env) echo "export SLURM_CONF=$conf" ;;
+  env) printf 'export SLURM_CONF=%q\n' "$conf" ;;
   *) echo "usage: $0 start|status|env|stop   (state in $state_dir)" >&2; exit 2 ;;
 esac

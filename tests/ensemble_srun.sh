@@ -10,7 +10,9 @@ bodyfit=$1 source_dir=$2 work=$3
 skip() { echo "SKIP: $*"; exit 77; }
 fail() { echo "FAIL: $*"; exit 1; }
 
-command -v srun > /dev/null && command -v sbatch > /dev/null || skip "no srun/sbatch on this host (Debian: slurm-wlm)"
+if ! command -v srun > /dev/null || ! command -v sbatch > /dev/null; then
+  skip "no srun/sbatch on this host (Debian: slurm-wlm)"
+fi
 # The throw-away cluster of scripts/slurm_local.sh, unless SLURM_CONF names another.
 local_conf=${BODYFIT_SLURM_DIR:-${TMPDIR:-/tmp}/bodyfit-slurm}/slurm.conf
 if [[ -z ${SLURM_CONF:-} && -s $local_conf ]]; then export SLURM_CONF=$local_conf; fi
