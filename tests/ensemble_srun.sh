@@ -75,9 +75,15 @@ grep -q '\[rank 1/2\]' srun.log || { cat srun.log; fail "srun -n 2 did not give 
 diff -r sequential srun || fail "srun -n 2 wrote other bytes than the sequential run"
 
 # The shipped batch script, through sbatch: the same bytes again.
-BODYFIT=$bodyfit sbatch --wait --time=5 --ntasks=2 --output=sbatch.log \
-  "$source_dir/docs/examples/ensemble.sbatch" case.toml sbatch > sbatch.submit 2>&1 ||
-  { cat sbatch.submit sbatch.log; fail "sbatch"; }
+# Polled here: `sbatch --wait` checks the job at growing intervals (tens of seconds).
+job=$(BODYFIT=$bodyfit sbatch --parsable --time=5 --ntasks=2 --output=sbatch.log \
+  "$source_dir/docs/examples/ensemble.sbatch" case.toml sbatch 2> sbatch.submit) || { cat sbatch.submit; fail "sbatch"; }
+for _ in $(seq 1 1500); do
+  [[ -n $(squeue -h -j "$job" 2> /dev/null) ]] || break
+  sleep 0.2
+done
+state=$(scontrol show job "$job" | grep -o 'JobState=[A-Z_]*')
+[[ $state == JobState=COMPLETED ]] || { cat sbatch.log; fail "batch job $job: ${state:-no state} (5 minutes at most)"; }
 grep -q '\[rank 1/2\]' sbatch.log || { cat sbatch.log; fail "the batch job did not run two ranks"; }
 diff -r sequential sbatch || fail "the batch job wrote other bytes than the sequential run"
 
@@ -90,6 +96,11 @@ fi
 [[ $(grep -c 'srun --mpi=pmix' none.log) == 2 ]] || { cat none.log; fail "srun --mpi=none: not refused by both tasks"; }
 [[ ! -e none ]] || fail "srun --mpi=none: an output directory was created"
 
+# A lone task without an interface has no one to join: it runs alone, the same bytes.
+srun --immediate=60 --mpi=none -n 1 "$bodyfit" --threads 1 ensemble case.toml -o single > single.log 2>&1 ||
+  { cat single.log; fail "srun --mpi=none -n 1"; }
+diff -r sequential single || fail "srun --mpi=none -n 1 wrote other bytes than the sequential run"
+
 # srun --mpi=pmi2: an MPI with a PMI-2 client joins (the sequential bytes); Open MPI, which speaks
 # PMIx only in Debian, is refused with the option to use instead of its advice to rebuild it.
 if srun --immediate=60 --mpi=pmi2 -n 2 "$bodyfit" --threads 1 ensemble case.toml -o pmi2 > pmi2.log 2>&1; then
@@ -98,4 +109,4 @@ else
   [[ $(grep -c 'run srun --mpi=pmix' pmi2.log) == 2 ]] || { cat pmi2.log; fail "srun --mpi=pmi2: no clear refusal"; }
   [[ ! -e pmi2 ]] || fail "srun --mpi=pmi2: an output directory was created"
 fi
-echo "srun -n 2 and sbatch: the sequential bytes; srun --mpi=none and pmi2 (Open MPI) refused"
+echo "srun -n 2, sbatch, srun --mpi=none -n 1: the sequential bytes; srun --mpi=none -n 2 and pmi2 (Open MPI) refused"
