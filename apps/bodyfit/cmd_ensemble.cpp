@@ -45,9 +45,27 @@ double peak_memory_mib() {
 /// The MPI job when asked (--mpi) or when a launcher started us, else this process alone.
 ProcessGroup process_group(bool mpi) {
   if (mpi) return ProcessGroup::join_mpi();
-  if (!started_by_mpi_launcher()) return ProcessGroup();
+  const LaunchEnvironment launch = read_launch_environment();
+  if (launch.launcher == LaunchEnvironment::Launcher::none) {
+    if (launch.allocation_tasks > 1)
+      spdlog::warn("this SLURM allocation has {} tasks, but bodyfit was not started by srun: this one process runs "
+                   "every member, on its own threads (--jobs); start it with `srun bodyfit ensemble ...` to spread "
+                   "the members over the tasks",
+                   launch.allocation_tasks);
+    return ProcessGroup();
+  }
+  // srun -n 1 without a process-management interface: there is no one to join (and Open MPI
+  // would abort in MPI_Init).
+  if (launch.launcher == LaunchEnvironment::Launcher::srun && launch.processes == 1 && !launch.pmix && !launch.pmi2)
+    return ProcessGroup();
   if constexpr (!config::have_mpi) {
-    spdlog::warn("started by an MPI launcher, but this bodyfit was built without MPI: each process runs the whole "
+    // Each of the launcher's processes would run every member into the same directory.
+    if (launch.processes > 1)
+      throw InputError(fmt::format("started by an MPI launcher with {} processes, but this bodyfit was built without "
+                                   "MPI (install libopenmpi-dev and reconfigure): run one process, with --jobs for "
+                                   "its threads",
+                                   launch.processes));
+    spdlog::warn("started by an MPI launcher, but this bodyfit was built without MPI: this process runs the whole "
                  "ensemble alone");
     return ProcessGroup();
   }

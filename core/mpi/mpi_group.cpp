@@ -3,10 +3,22 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstring>
 
 namespace bodyfit::mpi {
 namespace {
+
+void library_version(char* text, int size) {
+  if (size <= 0) return;
+  char version[MPI_MAX_LIBRARY_VERSION_STRING] = "";
+  int length = 0;
+  MPI_Get_library_version(version, &length);
+  const int kept = std::clamp(length, 0, size - 1);
+  std::memcpy(text, version, std::size_t(kept));
+  text[kept] = '\0';
+}
 
 bool init(int* rank, int* size, char* error, int error_size) {
   int initialised = 0;
@@ -41,7 +53,7 @@ void finalize() {
 
 void abort(int code) { MPI_Abort(MPI_COMM_WORLD, code); }
 
-constexpr Api kApi{kApiVersion, &init, &all_true, &finalize, &abort};
+constexpr Api kApi{kApiVersion, &library_version, &init, &all_true, &finalize, &abort};
 
 }  // namespace
 }  // namespace bodyfit::mpi

@@ -7,11 +7,14 @@
 
 namespace bodyfit::mpi {
 
-inline constexpr std::uint32_t kApiVersion = 1;
+inline constexpr std::uint32_t kApiVersion = 2;
 
 /// The module's entry points (MPI_COMM_WORLD; only the calling thread uses MPI).
 struct Api {
   std::uint32_t version = kApiVersion;
+  /// The MPI library's own name and version (MPI_Get_library_version, callable before MPI_Init),
+  /// at most `size` bytes with the terminating zero: which launch interfaces it speaks.
+  void (*library_version)(char* text, int size) = nullptr;
   /// MPI_Init_thread (funneled): this process's rank and the number of ranks; false with a
   /// message in `error` (of `error_size` bytes) when MPI cannot start.
   bool (*init)(int* rank, int* size, char* error, int error_size) = nullptr;
