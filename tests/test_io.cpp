@@ -1027,6 +1027,14 @@ TEST_CASE("OBJ and PLY polygons: every corner syntax, relative indices, quads as
       "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
       "element face 6\nproperty list uchar int vertex_indices\nend_header\n";
   check_cube("cube.ply", ply_header + kCubeVertices + cube_faces_text(""));
+  // Other elements are skipped, lists included; one without properties takes no bytes, however
+  // many instances it declares (and no time: nothing is read for it).
+  std::string skipping = ply_header;
+  skipping.replace(skipping.find("element face"), 0,
+                   "element material 2\nproperty list int float colour\nproperty uchar shine\n"
+                   "element nothing 1000000000000000\n");
+  std::string cube_ply_body = kCubeVertices + std::string("3 1 0.5 0.25 7\n0 9\n") + cube_faces_text(" ");
+  check_cube("skipping.ply", skipping + cube_ply_body);
   for (bool big_endian : {false, true}) {
     // Integer coordinates, unsigned short counts, unsigned indices: any scalar type.
     std::string header = fmt::format(
