@@ -382,7 +382,7 @@ TEST_CASE("mshdist-style .sol fixture with a scalar and a vector field") {
   CHECK(phi[3] == -0.125);
 }
 
-TEST_CASE("OBJ, OFF, PLY, STL round trips through OpenMesh") {
+TEST_CASE("OBJ, OFF, PLY, STL round trips (written by OpenMesh)") {
   TempDir dir("io-openmesh");
   auto mesh = make_sphere({.faces = 500});
   for (const char* name : {"s.obj", "s.off", "s.ply", "s.stl"}) {
@@ -909,6 +909,228 @@ TEST_CASE("OFF is read by bodyfit's parser: its variants give the same mesh, err
   // A duplicated face is caught by the builder every reader shares, at its line.
   m = read_error(dir, "twice.off", std::string("OFF\n8 7 0\n") + kCubeVertices + faces + "3 0 3 2\n");
   CHECK(contains(m, "twice.off:17: triangle 13: non-manifold edge"));
+}
+
+namespace {
+
+/// Binary PLY values in either byte order (the test machine is little-endian).
+class PlyEncoder {
+ public:
+  explicit PlyEncoder(bool big_endian) : big_endian_(big_endian) {}
+  template <class T>
+  PlyEncoder& put(T value) {
+    char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    if (big_endian_) std::reverse(raw, raw + sizeof(T));
+    bytes.append(raw, sizeof(T));
+    return *this;
+  }
+  std::string bytes;
+
+ private:
+  bool big_endian_;
+};
+
+/// A binary PLY of `mesh` with double coordinates, and properties and an element to skip: a
+/// vertex normal (float) and label (uchar) around x y z, an "edge" element with a list between
+/// the vertices and the faces, a face flag after the index list (uchar counts, int indices).
+std::string binary_ply(const SurfaceMesh& mesh, bool big_endian) {
+  std::string header = fmt::format(
+      "ply\nformat {} 1.0\ncomment written by test_io\nelement vertex {}\nproperty float nx\nproperty double x\n"
+      "property double y\nproperty uchar label\nproperty double z\nelement edge 2\nproperty list ushort int16 ends\n"
+      "property int weight\nelement face {}\nproperty list uchar int vertex_indices\nproperty short flag\nend_header\n",
+      big_endian ? "binary_big_endian" : "binary_little_endian", mesh.n_vertices(), mesh.n_faces());
+  PlyEncoder body(big_endian);
+  for (auto v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    body.put(float(0.5)).put(p[0]).put(p[1]).put(std::uint8_t(v.idx() % 251)).put(p[2]);
+  }
+  body.put(std::uint16_t(3)).put(std::int16_t(1)).put(std::int16_t(2)).put(std::int16_t(3)).put(std::int32_t(7));
+  body.put(std::uint16_t(0)).put(std::int32_t(-7));
+  for (auto f : mesh.faces()) {
+    body.put(std::uint8_t(3));
+    for (auto v : mesh.fv_range(f)) body.put(std::int32_t(v.idx()));
+    body.put(std::int16_t(-1));
+  }
+  return header + body.bytes;
+}
+
+/// The unit cube as an OBJ file, its quads written with every corner syntax and relative indices.
+std::string cube_obj() {
+  std::string text = "# a cube\nmtllib cube.mtl\no cube\n";
+  std::istringstream vertices(kCubeVertices);
+  for (std::string line; std::getline(vertices, line);) text += "v " + line + "\n";
+  text += "vt 0 0\nvt 1 0\nvn 0 0 1\ng sides\nusemtl grey\ns off\n";
+  const char* forms[6] = {"{}", "{}/1", "{}//1", "{}/2/1", "{}", "{}/1/1"};
+  for (int f = 0; f < 6; ++f) {
+    text += "f";
+    for (int c : kCubeQuads[f]) {
+      // Faces 4 and 5 count back from the last vertex (-1 is vertex 8).
+      const int index = f >= 4 ? c - 8 : c + 1;
+      text += ' ';
+      text += fmt::format(fmt::runtime(forms[f]), index);
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+}  // namespace
+
+TEST_CASE("OBJ and PLY are read by bodyfit's parsers: written meshes come back vertex for vertex") {
+  TempDir dir("io-objply");
+  const SurfaceMesh mesh = make_sphere({.faces = 500});
+  // The writers are OpenMesh's (OBJ, ASCII PLY): coordinates rounded to float and written with
+  // 17 digits, so read back exactly as the rounded coordinates.
+  for (const std::string name : {"s.obj", "s.ply"}) {
+    CAPTURE(name);
+    write_mesh(mesh, dir / name);
+    const SurfaceMesh back = read_mesh(dir / name);
+    REQUIRE(back.n_vertices() == mesh.n_vertices());
+    std::size_t different = 0;
+    for (auto v : mesh.vertices())
+      for (int k = 0; k < 3; ++k) {
+        const float written = static_cast<float>(mesh.point(v)[k]);
+        different += back.point(VertexHandle(v.idx()))[k] != double(written);  // (0 == -0: the sign is not kept)
+      }
+    CHECK(different == 0);
+    check_identical(mesh, back, false, 1e-7);  // the faces, in order
+  }
+  for (bool big_endian : {false, true}) {
+    CAPTURE(big_endian);
+    write_text(dir / "binary.ply", binary_ply(mesh, big_endian));
+    check_identical(mesh, read_mesh(dir / "binary.ply"), false);
+  }
+}
+
+TEST_CASE("OBJ and PLY polygons: every corner syntax, relative indices, quads as fans of the right area") {
+  TempDir dir("io-objply-cube");
+  auto check_cube = [&](const std::string& name, const std::string& text) {
+    INFO(name);
+    write_text(dir / name, text);
+    const SurfaceMesh mesh = read_mesh(dir / name);
+    CHECK(mesh.n_vertices() == 8);
+    CHECK(mesh.n_faces() == 12);
+    CHECK(total_area(mesh) == doctest::Approx(6).epsilon(1e-12));
+    CHECK(enclosed_volume(mesh) == doctest::Approx(1).epsilon(1e-12));
+  };
+  check_cube("cube.obj", cube_obj());
+  // A statement continued with '\', CRLF line ends, a vertex colour.
+  std::string continued = cube_obj();
+  continued.replace(continued.find("f 1 4"), 5, "f 1 \\\n  4");
+  continued.replace(continued.find("v 0 0 0"), 7, "v 0 0 0 0.5 0.5 0.5");
+  std::string crlf;
+  for (char c : continued) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  check_cube("continued.obj", crlf);
+
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 6\nproperty list uchar int vertex_indices\nend_header\n";
+  check_cube("cube.ply", ply_header + kCubeVertices + cube_faces_text(""));
+  // Other elements are skipped, lists included; one without properties takes no bytes, however
+  // many instances it declares (and no time: nothing is read for it).
+  std::string skipping = ply_header;
+  skipping.replace(skipping.find("element face"), 0,
+                   "element material 2\nproperty list int float colour\nproperty uchar shine\n"
+                   "element nothing 1000000000000000\n");
+  std::string cube_ply_body = kCubeVertices + std::string("3 1 0.5 0.25 7\n0 9\n") + cube_faces_text(" ");
+  check_cube("skipping.ply", skipping + cube_ply_body);
+  for (bool big_endian : {false, true}) {
+    // Integer coordinates, unsigned short counts, unsigned indices: any scalar type.
+    std::string header = fmt::format(
+        "ply\nformat {} 1.0\nelement vertex 8\nproperty int x\nproperty short y\nproperty uchar z\n"
+        "element face 6\nproperty list ushort uint vertex_index\nend_header\n",
+        big_endian ? "binary_big_endian" : "binary_little_endian");
+    PlyEncoder body(big_endian);
+    std::istringstream vertices(kCubeVertices);
+    for (int x, y, z; vertices >> x >> y >> z;) body.put(std::int32_t(x)).put(std::int16_t(y)).put(std::uint8_t(z));
+    for (const auto& q : kCubeQuads) {
+      body.put(std::uint16_t(4));
+      for (int c : q) body.put(std::uint32_t(c));
+    }
+    check_cube(big_endian ? "big.ply" : "little.ply", header + body.bytes);
+  }
+}
+
+TEST_CASE("bad OBJ and PLY files: each error names the file, its line (or byte) and what was expected") {
+  TempDir dir("io-objply-bad");
+  const std::string cube = cube_obj();  // vertices on lines 4-11, faces on 18-23
+  auto with_line = [&](int number, const std::string& line) {
+    std::istringstream in(cube);
+    std::string text;
+    int n = 0;
+    for (std::string l; std::getline(in, l);) text += (++n == number ? line : l) + "\n";
+    return text;
+  };
+  auto m = read_error(dir, "range.obj", with_line(18, "f 1 4 9"));
+  CHECK(contains(m, "range.obj:18: face 1: vertex index 9 is out of range: 8 vertices are defined before this line"));
+  m = read_error(dir, "relative.obj", with_line(18, "f -1 -4 -9"));
+  CHECK(contains(m, "relative.obj:18: face 1: vertex index -9 is out of range"));
+  m = read_error(dir, "zero.obj", with_line(19, "f 0 1 2"));
+  CHECK(contains(m, "zero.obj:19: face 2: corner '0' is not v, v/vt, v//vn or v/vt/vn"));
+  m = read_error(dir, "corner.obj", with_line(19, "f 1/x 2 3"));
+  CHECK(contains(m, "corner.obj:19: face 2: corner '1/x'"));
+  m = read_error(dir, "two.obj", with_line(20, "f 1 2"));
+  CHECK(contains(m, "two.obj:20: face 3 has 2 corners, expected at least 3"));
+  m = read_error(dir, "number.obj", with_line(5, "v 1 zero 0"));
+  CHECK(contains(m, "number.obj:5: vertex 2: 'zero' is not a number"));
+  m = read_error(dir, "short.obj", with_line(5, "v 1 0"));
+  CHECK(contains(m, "short.obj:5: vertex 2: expected 3 coordinates"));
+  m = read_error(dir, "garbage.obj", with_line(12, "hello world"));
+  CHECK(contains(m, "garbage.obj:12: 'hello' is not an OBJ statement"));
+  m = read_error(dir, "curve.obj", with_line(12, "curv 0 1 1 2"));
+  CHECK(contains(m, "curve.obj:12: 'curv': OBJ free-form curves and surfaces are not supported"));
+  // A continued statement is reported at its first line; the lines after it keep their numbers.
+  std::string continued = with_line(12, "vt 0 \\");
+  continued.replace(continued.find("vt 1 0"), 6, "  1");
+  m = read_error(dir, "continued.obj", continued.replace(continued.find("f 1 4"), 5, "f 1 44"));
+  CHECK(contains(m, "continued.obj:18: face 1: vertex index 44"));
+  // The builder every reader shares: an unused vertex at its line.
+  m = read_error(dir, "unused.obj", cube + "v 9 9 9\n");
+  CHECK(contains(m, "unused.obj:24: vertex 9 is not a corner of any triangle"));
+
+  const std::string head = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string ply = head + kCubeVertices + cube_faces_text("");  // vertices on lines 10-17, faces 18-23
+  m = read_error(dir, "word.ply", head + "0 0 0\n1 zero 0\n" + ply.substr(ply.find("1 1 0")));
+  CHECK(contains(m, "word.ply:11: vertex 2 (property 'y'): 'zero' is not a number"));
+  m = read_error(dir, "index.ply", ply.substr(0, ply.find("4 4 5")) + "4 4 5 6 8\n" + ply.substr(ply.find("4 0 1 5")));
+  CHECK(contains(m, "index.ply:19: face 2: corner 8 is not a vertex index (0 to 7)"));
+  m = read_error(dir, "corners.ply", ply.substr(0, ply.find("4 4 5")) + "2 4 5\n" + ply.substr(ply.find("4 0 1 5")));
+  CHECK(contains(m, "corners.ply:19: face 2: 2 corners, expected at least 3"));
+  m = read_error(dir, "long.ply", ply.substr(0, ply.find("4 4 5")) + "200 4 5\n");
+  CHECK(contains(m, "long.ply:19: face 2: 200 corners, more than the rest of the file holds"));
+  m = read_error(dir, "cut.ply", head + "0 0 0\n");
+  CHECK(contains(m, "declares 8 vertices and 6 faces"));
+  m = read_error(dir, "ends.ply", ply.substr(0, ply.size() - 10) + std::string(40, '\n'));
+  CHECK(contains(m, "the file ends within face 6 (property 'vertex_indices') of 6"));
+  m = read_error(dir, "typo.ply", "ply\nformat ascii 1.0\nelement vertex 8\nproperty flaot x\n");
+  CHECK(contains(m, "typo.ply:4: PLY header: 'flaot' is not a PLY type"));
+  m = read_error(dir, "noz.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n0 0\n");
+  CHECK(contains(m, "noz.ply:3: PLY header: the vertex element needs the properties x, y and z"));
+  m = read_error(dir, "nolist.ply", "ply\nformat ascii 1.0\nelement face 1\nproperty int vertex_indices\nend_header\n3\n");
+  CHECK(contains(m, "nolist.ply:4: PLY header: 'vertex_indices' must be a list of an integer type"));
+  m = read_error(dir, "format.ply", "ply\nformat binary 1.0\nend_header\n");
+  CHECK(contains(m, "format.ply:2: PLY header: unknown format 'binary'"));
+  m = read_error(dir, "noend.ply", "ply\nformat ascii 1.0\nelement vertex 0\n");
+  CHECK(contains(m, "no 'end_header' line"));
+  m = read_error(dir, "notply.ply", "PLY\n");
+  CHECK(contains(m, "notply.ply:1: not a PLY file"));
+  // Binary: truncated within a face, and a list count beyond the file, at their byte.
+  const SurfaceMesh mesh = make_sphere({.faces = 20});
+  std::string binary = binary_ply(mesh, true);
+  const std::size_t faces = mesh.n_faces();
+  m = read_error(dir, "truncated.ply", binary.substr(0, binary.size() - 5));
+  CHECK(contains(m, fmt::format("truncated.ply: byte {}: face {}: 3 corners, more than the rest of the file holds",
+                                binary.size() - 15, faces)));
+  m = read_error(dir, "flag.ply", binary.substr(0, binary.size() - 1));
+  CHECK(contains(m, fmt::format("flag.ply: byte {}: the file ends within face {} (property 'flag') of {}",
+                                binary.size() - 2, faces, faces)));
+  // The first edge's count, after the vertices (29 bytes each).
+  const std::size_t edge = binary.find("end_header\n") + 11 + mesh.n_vertices() * (4 + 3 * 8 + 1);
+  binary[edge] = char(0xff), binary[edge + 1] = char(0xff);
+  m = read_error(dir, "list.ply", binary);
+  CHECK(contains(m, "edge 1 (property 'ends'): a list of 65535 items, more than the rest of the file holds"));
 }
 
 TEST_CASE("writers: unknown extension or missing directory throws and leaves no file") {

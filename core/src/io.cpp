@@ -349,7 +349,9 @@ SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& opti
   const std::string ext = extension_of(file);
   if (ext == ".mesh" || ext == ".meshb") return read_medit(file, options);
   if (ext == ".off") return read_off(file, options);
-  if (ext == ".obj" || ext == ".ply" || ext == ".stl") return read_openmesh_format(file, options);
+  if (ext == ".obj") return read_obj(file, options);
+  if (ext == ".ply") return read_ply(file, options);
+  if (ext == ".stl") return read_openmesh_format(file, options);
   throw file_error(file, fmt::format("unknown mesh extension '{}' (expected .mesh, .meshb, .obj, .off, .ply or .stl)",
                                      ext));
 }

@@ -128,6 +128,13 @@ void write_medit(const SurfaceMesh& mesh, const std::filesystem::path& file, boo
 /// The records of an OFF file's bytes (text or binary), before build_mesh.
 MeshRecords parse_off(std::string_view bytes, const std::filesystem::path& file);
 SurfaceMesh read_off(const std::filesystem::path& file, const ReadOptions& options);
+/// The records of an OBJ file's bytes, before build_mesh.
+MeshRecords parse_obj(std::string_view bytes, const std::filesystem::path& file);
+SurfaceMesh read_obj(const std::filesystem::path& file, const ReadOptions& options);
+/// The records of a PLY file's bytes (ASCII or binary), before build_mesh.
+MeshRecords parse_ply(std::string_view bytes, const std::filesystem::path& file);
+SurfaceMesh read_ply(const std::filesystem::path& file, const ReadOptions& options);
+/// STL through OpenMesh's reader.
 SurfaceMesh read_openmesh_format(const std::filesystem::path& file, const ReadOptions& options);
 void write_openmesh_format(const SurfaceMesh& mesh, const std::filesystem::path& file);
 

@@ -9,7 +9,7 @@ enum class Reader {
   MeshText,    ///< Medit .mesh (in memory: parse_medit + build_mesh)
   MeshBinary,  ///< Medit .meshb (in memory)
   Sol,         ///< read_sol_all on a .solb when the bytes start with a binary Medit code, else a .sol
-  OpenMesh,    ///< read_mesh on .obj, .off or .stl: the first byte chooses (byte % 3), the rest is the file
+  OpenMesh,    ///< read_mesh on .obj, .off, .stl or .ply: the first byte chooses (byte % 4), the rest is the file
   EsriGrid,    ///< read_esri_ascii
   Case,        ///< read_case: the TOML case loader
   Checkpoint,  ///< read_checkpoint (in memory)

@@ -4,7 +4,7 @@
 //   .mesh / .meshb   Medit ASCII / binary (MMG, Mshdist, Advection, FreeFEM): vertices, triangles,
 //                    edges, ridges, corners, required vertices and edges, with their refs
 //   .sol  / .solb    Medit solution files: scalar or vector fields at the vertices
-//   .obj .off .ply .stl  read (and written) through OpenMesh's IO
+//   .obj .off .ply .stl  OBJ, OFF, PLY read by bodyfit's parsers, STL by OpenMesh; all written by OpenMesh
 //   .vtu / .pvd      VTK XML unstructured grid (binary appended) and ParaView time series
 //
 // Every reader validates what it reads: a malformed or truncated file, an index out of range,

@@ -1,0 +1,88 @@
+#pragma once
+// Private to the text readers (io_off.cpp, io_obj.cpp, io_ply.cpp): lines with their numbers,
+// the words of a line, numbers parsed whole, polygons as fans, counts checked against the length.
+#include "io_internal.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string_view>
+
+namespace bodyfit::io_detail {
+
+inline bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// The lines of a text file with '#' comments removed, empty ones skipped, numbered from 1.
+class Lines {
+ public:
+  explicit Lines(std::string_view text) : text_(text) {}
+  /// The next non-empty line (without its comment), or nullopt at the end.
+  std::optional<std::string_view> next() {
+    while (at_ < text_.size()) {
+      const std::size_t end = std::min(text_.find('\n', at_), text_.size());
+      std::string_view line = text_.substr(at_, end - at_);
+      at_ = end + 1;
+      ++number_;
+      line = line.substr(0, line.find('#'));
+      if (line.find_first_not_of(" \t\r\f\v") != std::string_view::npos) return line;
+    }
+    return std::nullopt;
+  }
+  long number() const { return number_; }
+  std::size_t offset() const { return std::min(at_, text_.size()); }
+
+ private:
+  std::string_view text_;
+  std::size_t at_ = 0;
+  long number_ = 0;
+};
+
+/// Whitespace-separated words of one line.
+class Words {
+ public:
+  explicit Words(std::string_view line) : line_(line) {}
+  std::string_view next() {
+    while (at_ < line_.size() && is_blank(line_[at_])) ++at_;
+    const std::size_t start = at_;
+    while (at_ < line_.size() && !is_blank(line_[at_])) ++at_;
+    return line_.substr(start, at_ - start);
+  }
+
+ private:
+  std::string_view line_;
+  std::size_t at_ = 0;
+};
+
+/// `word` as a whole number of type T (a leading '+' allowed); false if any of it is not.
+template <class T>
+bool parse_number(std::string_view word, T& value) {
+  if (word.size() > 1 && word[0] == '+' && word[1] != '-') word.remove_prefix(1);
+  const auto [end, error] = std::from_chars(word.data(), word.data() + word.size(), value);
+  return error == std::errc() && end == word.data() + word.size();
+}
+
+/// Each record takes at least a few bytes: counts the file cannot hold are an error before any
+/// memory is reserved for them (a damaged header is not a 137 GB allocation).
+inline void check_counts_fit(std::uint64_t vertices, std::uint64_t faces, double vertex_bytes, double face_bytes,
+                             std::uint64_t size, const std::filesystem::path& file) {
+  const double needed = double(vertices) * vertex_bytes + double(faces) * face_bytes;
+  if (needed > double(size))
+    throw file_error(file, fmt::format("the header declares {} vertices and {} faces, which need at least {:.0f} bytes; "
+                                       "the file has {} (truncated or not this format?)",
+                                       vertices, faces, needed, size));
+}
+
+/// A polygon of `count` corners as the fan of triangles (0, i, i+1), as OpenMesh did; `line` is
+/// where it was read (ignored by a locator that has no lines).
+inline void add_fan(MeshRecords& records, const std::int64_t* corners, std::int64_t count, long line) {
+  for (std::int64_t i = 1; i + 1 < count; ++i) {
+    records.triangles.push_back({corners[0], corners[i], corners[i + 1]});
+    records.triangle_at.push_line(line);
+  }
+}
+
+}  // namespace bodyfit::io_detail
