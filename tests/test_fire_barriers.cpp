@@ -327,4 +327,27 @@ TEST_CASE("coordinate systems: with the DEM reprojected to UTM, a fuel map in de
   CHECK(inside > 100);
   CHECK(outside > 1000);
   CHECK(wrong == 0);
+
+  // A barrier layer in degrees (GeoJSON without a crs member: WGS 84, RFC 7946) is transformed to
+  // the surface's UTM: a polygon over the block stops the fire exactly where its transformed corners
+  // say, within the band of 2 × the longest edge.
+  write_text(dir / "block.geojson",
+             geojson({fmt::format(R"({{"type":"Polygon","coordinates":[[[{0},{2}],[{1},{2}],[{1},{3}],[{0},{3}],[{0},{2}]]]}})",
+                                  block_west, block_east, block_south, block_north)}));
+  std::vector<PlanPoint> corners = {{block_west, block_south}, {block_east, block_south}, {block_east, block_north},
+                                    {block_west, block_north}};
+  transform_points(kWgs84, coordinates.crs, corners, "corners");
+  const PlanPolygon block{{corners}};
+  LoadedModel barred = fire_model();
+  configure_model(barred, toml::parse(fmt::format("[barriers]\nfile = '{}'\n", (dir / "block.geojson").string())), surface);
+  const VelocityField barred_field = barred->compute(context);
+  const double reach = 2 * fire::longest_plan_edge(mesh);
+  std::size_t stopped = 0, mismatched = 0;
+  for (auto v : mesh.vertices()) {
+    const bool expected = signed_distance_to_polygon(block, mesh.point(v)[0], mesh.point(v)[1]) <= reach;
+    stopped += expected;
+    mismatched += expected ? barred_field.normal_speed[v.idx()] != 0 : barred_field.normal_speed[v.idx()] != R0;
+  }
+  CHECK(stopped > 300);
+  CHECK(mismatched == 0);
 }
