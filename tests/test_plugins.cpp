@@ -162,10 +162,10 @@ TEST_CASE("bodyfit plugins lists names, versions, ABI, files, parameters and fai
   auto result = test::run_bodyfit("plugins");
   CAPTURE(result.output);
   CHECK(result.exit_code == 0);
-  CHECK(contains(result.output, "conormal 1.0  (ABI 2.3)"));
+  CHECK(contains(result.output, "conormal 1.0  (ABI 2.4)"));
   CHECK(contains(result.output, "bodyfit_conormal.so"));
   CHECK(contains(result.output, "speed = 1"));
-  CHECK(contains(result.output, "testgood 2.5  (ABI 2.3)"));
+  CHECK(contains(result.output, "testgood 2.5  (ABI 2.4)"));
   CHECK(contains(result.output, "value = 0.5"));
   CHECK(contains(result.output, "constant normal speed (test)"));
   CHECK(contains(result.output, "2 files failed to load"));

@@ -329,7 +329,7 @@ int run_case(const RunArguments& args) {
   report_model_crashes(std::string(model->name()));
   {
     PluginCall call("configure", -1);
-    configure_model(model, config.model_parameters);
+    configure_model(model, config.model_parameters, case_surface_source(config));
   }
   spdlog::info("model '{}' ({})", model->name(), model.file().string());
 

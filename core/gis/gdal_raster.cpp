@@ -88,10 +88,24 @@ bool describe_crs(const std::string& wkt, CrsInfo& info, std::string& error) {
   if (OSRIsProjected(srs.h)) info.metres_per_unit = OSRGetLinearUnits(srs.h, nullptr);
   CPLPushErrorHandler(CPLQuietErrorHandler);
   OSRAutoIdentifyEPSG(srs.h);
-  CPLPopErrorHandler();
   const char* authority = OSRGetAuthorityName(srs.h, nullptr);
   const char* code = OSRGetAuthorityCode(srs.h, nullptr);
-  if (authority && code && std::string(authority) == "EPSG") info.epsg = std::atoi(code);
+  if (authority && code && std::string(authority) == "EPSG") {
+    info.epsg = std::atoi(code);
+  } else {
+    // An ESRI .prj carries no authority: the EPSG system PROJ finds equivalent, when it is sure.
+    int count = 0;
+    int* confidence = nullptr;
+    OGRSpatialReferenceH* matches = OSRFindMatches(srs.h, nullptr, &count, &confidence);
+    if (matches && count > 0 && confidence && confidence[0] >= 90) {
+      const char* match_authority = OSRGetAuthorityName(matches[0], nullptr);
+      const char* match_code = OSRGetAuthorityCode(matches[0], nullptr);
+      if (match_authority && match_code && std::string(match_authority) == "EPSG") info.epsg = std::atoi(match_code);
+    }
+    if (matches) OSRFreeSRSArray(matches);
+    CPLFree(confidence);
+  }
+  CPLPopErrorHandler();
   return true;
 }
 
@@ -168,7 +182,8 @@ double two_significant(double x) {
   return std::round(x / unit) * unit;
 }
 
-bool warp_raster(const HeightGrid& in, int epsg, double cell_size, HeightGrid& out, std::string& error) {
+bool warp_raster(const HeightGrid& in, int epsg, double cell_size, Resampling resampling, HeightGrid& out,
+                 std::string& error) {
   auto fail = [&](std::string what) {
     error = fmt::format("{} (GDAL: {})", what, CPLGetLastErrorMsg());
     return false;
@@ -257,7 +272,7 @@ bool warp_raster(const HeightGrid& in, int epsg, double cell_size, HeightGrid& o
   options->padfSrcNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
   options->padfDstNoDataReal = static_cast<double*>(CPLMalloc(sizeof(double)));
   options->padfSrcNoDataReal[0] = options->padfDstNoDataReal[0] = in.nodata;
-  options->eResampleAlg = GRA_Bilinear;
+  options->eResampleAlg = resampling == Resampling::nearest ? GRA_NearestNeighbour : GRA_Bilinear;
   options->papszWarpOptions = CSLSetNameValue(options->papszWarpOptions, "INIT_DEST", "NO_DATA");
   options->pTransformerArg =
       GDALCreateGenImgProjTransformer(source.h, in.crs.c_str(), target_data.h, target_wkt.c_str(), FALSE, 0, 1);
@@ -287,7 +302,8 @@ const Api kApi{.version = kApiVersion,
                .write_geotiff = write_geotiff,
                .read_vector = read_vector,
                .write_polygons = write_polygons,
-               .warp_raster = warp_raster};
+               .warp_raster = warp_raster,
+               .transform_points = transform_points};
 
 }  // namespace
 }  // namespace bodyfit::gis

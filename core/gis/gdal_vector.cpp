@@ -7,6 +7,7 @@
 #include <ogr_api.h>
 #include <ogr_srs_api.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cstdlib>
 #include <variant>
@@ -116,7 +117,7 @@ OGRGeometryH make_multipolygon(const std::vector<PlanPolygon>& polygons) {
 
 }  // namespace
 
-bool read_vector(const std::filesystem::path& file, VectorLayer& layer, std::string& error) {
+bool read_vector(const std::filesystem::path& file, const std::string& name, VectorLayer& layer, std::string& error) {
   GDALAllRegister();
   CPLErrorReset();
   CPLPushErrorHandler(CPLQuietErrorHandler);
@@ -131,7 +132,14 @@ bool read_vector(const std::filesystem::path& file, VectorLayer& layer, std::str
     error = "the file has no layer";
     return false;
   }
-  OGRLayerH source = GDALDatasetGetLayer(dataset, 0);
+  OGRLayerH source = name.empty() ? GDALDatasetGetLayer(dataset, 0) : GDALDatasetGetLayerByName(dataset, name.c_str());
+  if (!source) {
+    std::vector<std::string> names;
+    for (int i = 0; i < GDALDatasetGetLayerCount(dataset); ++i)
+      names.push_back(OGR_L_GetName(GDALDatasetGetLayer(dataset, i)));
+    error = fmt::format("no layer named '{}' (the file has: {})", name, fmt::join(names, ", "));
+    return false;
+  }
   layer = VectorLayer{};
   layer.name = OGR_L_GetName(source);
   if (OGRSpatialReferenceH srs = OGR_L_GetSpatialRef(source)) {
@@ -237,6 +245,33 @@ bool write_polygons(const std::filesystem::path& file, const std::string& driver
   GDALClose(dataset);  // flushes: a full disk shows here
   if (CPLGetLastErrorType() >= CE_Failure) return gdal_failure("cannot write the file");
   return true;
+}
+
+bool transform_points(const std::string& from, const std::string& to, std::vector<PlanPoint>& points,
+                      std::string& error) {
+  OGRSpatialReferenceH source = OSRNewSpatialReference(nullptr), target = OSRNewSpatialReference(nullptr);
+  OGRCoordinateTransformationH transform = nullptr;
+  CPLErrorReset();
+  CPLPushErrorHandler(CPLQuietErrorHandler);
+  if (OSRSetFromUserInput(source, from.c_str()) == OGRERR_NONE && OSRSetFromUserInput(target, to.c_str()) == OGRERR_NONE) {
+    // x, y as bodyfit reads them from OGR's geometries: longitude first in a geographic system.
+    OSRSetAxisMappingStrategy(source, OAMS_TRADITIONAL_GIS_ORDER);
+    OSRSetAxisMappingStrategy(target, OAMS_TRADITIONAL_GIS_ORDER);
+    transform = OCTNewCoordinateTransformation(source, target);
+  }
+  bool ok = transform != nullptr;
+  if (!ok) error = fmt::format("no transformation between the coordinate systems (GDAL: {})", CPLGetLastErrorMsg());
+  for (std::size_t i = 0; ok && i < points.size(); ++i) {
+    double x = points[i][0], y = points[i][1], z = 0;
+    ok = OCTTransform(transform, 1, &x, &y, &z) != 0;
+    if (ok) points[i] = {x, y};
+    else error = fmt::format("cannot transform the point ({}, {}) (GDAL: {})", points[i][0], points[i][1], CPLGetLastErrorMsg());
+  }
+  CPLPopErrorHandler();
+  if (transform) OCTDestroyCoordinateTransformation(transform);
+  OSRDestroySpatialReference(source);
+  OSRDestroySpatialReference(target);
+  return ok;
 }
 
 }  // namespace bodyfit::gis

@@ -2,6 +2,7 @@
 // initial region G(0) meshed into T^0, and the evolution options.
 #include <bodyfit/case_config.hpp>
 #include <bodyfit/clock_time.hpp>
+#include <bodyfit/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/guards.hpp>
@@ -60,10 +61,10 @@ double ignition_time(const CaseConfig& config, const AttributeValue& value, std:
 std::vector<Ignition> read_ignitions(const CaseConfig& config) {
   const auto& r = config.region;
   const VectorLayer layer = read_vector_layer(r.ignitions);
-  if (!layer.crs.empty()) {
-    HeightGrid as_grid;  // require_same_crs compares rasters' CRS: the layer's as one
-    as_grid.crs = layer.crs;
-    if (!config.surface.dem.empty()) require_same_crs(read_dem(config.surface.dem), config.surface.dem, as_grid, r.ignitions);
+  // The surface's system (after its reprojection, when the case asks for one), not the DEM file's.
+  if (!layer.crs.empty() && !config.surface.dem.empty()) {
+    const SurfaceSource surface = case_surface_source(config);
+    require_crs(layer.crs, r.ignitions, surface.crs, surface.dem);
   }
   std::vector<Ignition> ignitions;
   for (std::size_t i = 0; i < layer.features.size(); ++i) {
@@ -107,6 +108,13 @@ SurfaceMesh make_case_surface(const CaseConfig& config) {
       return make_plane(s.plane);
   }
   return {};
+}
+
+SurfaceSource case_surface_source(const CaseConfig& config) {
+  const auto& s = config.surface;
+  if (s.kind != SurfaceSpec::Kind::Terrain || s.dem.empty()) return {};
+  DemCoordinates coordinates = dem_coordinates(s.dem, {.reproject = s.reproject});
+  return {.dem = s.dem, .crs = std::move(coordinates.crs), .reprojected_from = std::move(coordinates.reprojected_from)};
 }
 
 ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surface) {

@@ -194,24 +194,41 @@ void require_metres(const HeightGrid& grid, const std::filesystem::path& file) {
                                        info.name, info.metres_per_unit));
 }
 
-/// A geographic raster warped to the UTM zone of its centre (through the GDAL module), said in the
-/// log; any other raster is returned as it is.
-HeightGrid reproject_to_utm(HeightGrid grid, const std::filesystem::path& file) {
+/// A geographic raster warped to the UTM zone of its centre, or to options.target_crs (through the
+/// GDAL module), said in the log; any other raster is returned as it is.
+HeightGrid reproject_to_utm(HeightGrid grid, const std::filesystem::path& file, const DemReadOptions& options) {
   if (grid.crs.empty()) return grid;  // nothing to reproject from: require_metres warns if it looks like degrees
   const gis::Api& gis = gis::module_for(file);
   gis::CrsInfo from;
   std::string error;
   if (!gis.describe_crs(grid.crs, from, error)) throw file_error(file, error);
   if (!from.geographic) return grid;
-  const UtmZone zone = utm_zone_of(grid);
+  int epsg = utm_zone_of(grid).epsg();
+  if (!options.target_crs.empty()) {
+    gis::CrsInfo target;
+    if (!gis.describe_crs(options.target_crs, target, error)) throw file_error(file, error);
+    if (target.epsg == 0 || target.geographic)
+      throw file_error(file, fmt::format("cannot reproject it to '{}', a system without an EPSG code or in degrees",
+                                         target.name));
+    epsg = target.epsg;
+  }
   HeightGrid warped;
-  if (!gis.warp_raster(grid, zone.epsg(), 0, warped, error))
-    throw file_error(file, fmt::format("cannot reproject it to EPSG:{}: {}", zone.epsg(), error));
+  if (!gis.warp_raster(grid, epsg, 0, options.resampling, warped, error))
+    throw file_error(file, fmt::format("cannot reproject it to EPSG:{}: {}", epsg, error));
   gis::CrsInfo to;
   if (!gis.describe_crs(warped.crs, to, error)) throw file_error(file, error);
-  spdlog::info("{}: reprojected from {} to {}, {} m cells ({} × {}, bilinear, NODATA kept)", file.string(), from.name,
-               to.name, warped.cell_size, warped.cols, warped.rows);
+  spdlog::info("{}: reprojected from {} to {}, {} m cells ({} × {}, {}, NODATA kept)", file.string(), from.name,
+               to.name, warped.cell_size, warped.cols, warped.rows,
+               options.resampling == Resampling::nearest ? "nearest cell" : "bilinear");
   return warped;
+}
+
+/// The raster as the file holds it, with a terrain's checks.
+HeightGrid read_dem_as_is(const std::filesystem::path& file) {
+  const std::string ext = lower(file.extension().string());
+  if (ext == ".asc") return read_esri_ascii(file);
+  if (ext == ".tif" || ext == ".tiff") return read_geotiff(file);
+  throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
 }
 
 }  // namespace
@@ -346,14 +363,22 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
 }
 
 HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options) {
-  const std::string ext = lower(file.extension().string());
-  HeightGrid grid;
-  if (ext == ".asc") grid = read_esri_ascii(file);
-  else if (ext == ".tif" || ext == ".tiff") grid = read_geotiff(file);
-  else throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
-  if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file);
+  HeightGrid grid = read_dem_as_is(file);
+  if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file, options);
   require_metres(grid, file);
   return grid;
+}
+
+DemCoordinates dem_coordinates(const std::filesystem::path& file, const DemReadOptions& options) {
+  HeightGrid grid = read_dem_as_is(file);
+  DemCoordinates coordinates{.crs = grid.crs};
+  if (options.reproject == Reprojection::utm) {
+    const std::string own = grid.crs;
+    grid = reproject_to_utm(std::move(grid), file, options);
+    if (grid.crs != own) coordinates = {.crs = grid.crs, .reprojected_from = own};
+  }
+  require_metres(grid, file);
+  return coordinates;
 }
 
 void require_same_crs(const HeightGrid& a, const std::filesystem::path& file_a, const HeightGrid& b,

@@ -91,7 +91,7 @@ bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const fs::pa
   overrides.push_back("model.perimeters.file=\"\"");
   CaseConfig config = read_case(run.case_file, overrides);
   LoadedModel model = load_model(config.model);
-  configure_model(model, config.model_parameters);
+  configure_model(model, config.model_parameters, case_surface_source(config));
   CaseSetup setup = setup_case(config);
   if (region_area(setup.mesh, kInside) <= 0)
     throw InputError(fmt::format("the ignition disk at ({}, {}) of radius {} covers no face of the surface (outside "

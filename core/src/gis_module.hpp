@@ -15,7 +15,7 @@
 
 namespace bodyfit::gis {
 
-inline constexpr std::uint32_t kApiVersion = 3;
+inline constexpr std::uint32_t kApiVersion = 4;
 
 /// What bodyfit needs to know of a coordinate system.
 struct CrsInfo {
@@ -41,18 +41,25 @@ struct Api {
   /// metadata; false with `error` set when GDAL cannot write it. (version 2)
   bool (*write_geotiff)(const std::filesystem::path& file, const HeightGrid& grid, double nodata,
                         const RasterMetadata& metadata, std::string& error) = nullptr;
-  /// The first layer of a vector file (OGR), each feature's validity by OGR_G_IsValid; false with
-  /// `error` set when OGR cannot read it. (version 2)
-  bool (*read_vector)(const std::filesystem::path& file, VectorLayer& layer, std::string& error) = nullptr;
+  /// The layer named `name` of a vector file (OGR; "" the first), each feature's validity by
+  /// OGR_G_IsValid; false with `error` set when OGR cannot read it or has no such layer. (version 4)
+  bool (*read_vector)(const std::filesystem::path& file, const std::string& name, VectorLayer& layer,
+                      std::string& error) = nullptr;
   /// A layer of MultiPolygons created at `file` with the OGR driver `driver` ("GPKG", "GeoJSON");
   /// false with `error` set on failure. (version 2)
   bool (*write_polygons)(const std::filesystem::path& file, const std::string& driver, const VectorLayer& layer,
                          std::string& error) = nullptr;
   /// `grid` (its coordinate system in grid.crs) warped to EPSG:`epsg` into `out` with GDAL's warper:
-  /// bilinear over valid cells, NODATA kept (cells outside the source too), square cells of
-  /// `cell_size` (0: GDAL's suggested size rounded to two significant figures) on a lattice aligned
-  /// with multiples of the cell size; out.crs is the target's WKT. False with `error` set on failure. (version 3)
-  bool (*warp_raster)(const HeightGrid& grid, int epsg, double cell_size, HeightGrid& out, std::string& error) = nullptr;
+  /// bilinear or nearest over valid cells, NODATA kept (cells outside the source too), square cells
+  /// of `cell_size` (0: GDAL's suggested size rounded to two significant figures) on a lattice
+  /// aligned with multiples of the cell size; out.crs is the target's WKT. False with `error` set on
+  /// failure. (version 3; the resampling since 4)
+  bool (*warp_raster)(const HeightGrid& grid, int epsg, double cell_size, Resampling resampling, HeightGrid& out,
+                      std::string& error) = nullptr;
+  /// Points (x, y; longitude, latitude in a geographic system) from the system `from` to `to` (both
+  /// WKT), in place; false with `error` set when there is no transformation or a point fails. (version 4)
+  bool (*transform_points)(const std::string& from, const std::string& to, std::vector<PlanPoint>& points,
+                           std::string& error) = nullptr;
 };
 
 /// The module, loaded on the first call. An InputError naming `file` when bodyfit was built

@@ -207,9 +207,10 @@ LoadedModel load_model(std::string_view name) {
   throw InputError(message);
 }
 
-void configure_model(LoadedModel& model, const toml::table& parameters) {
+void configure_model(LoadedModel& model, const toml::table& parameters, const SurfaceSource& surface) {
   const std::string where = model.file().string();
   try {
+    if ((model.abi() & 0xffffu) >= 4) model->set_surface(surface);
     model->configure(parameters);
   } catch (const InputError& e) {
     throw file_error(model.file(), fmt::format("configure failed: {}", e.what()));

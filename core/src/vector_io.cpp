@@ -18,13 +18,13 @@ const AttributeValue& VectorFeature::attribute(const std::string& name) const {
   return null;
 }
 
-VectorLayer read_vector_layer(const std::filesystem::path& file) {
+VectorLayer read_vector_layer(const std::filesystem::path& file, const std::string& name) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw file_error(file, "no such file");
   const gis::Api& gis = gis::module_for(file);
   VectorLayer layer;
   std::string error;
-  if (!gis.read_vector(file, layer, error)) throw file_error(file, error);
+  if (!gis.read_vector(file, name, layer, error)) throw file_error(file, error);
   return layer;
 }
 

@@ -2,10 +2,12 @@
 // normal speed R (rate of spread, formula 4.8) computed at every vertex from the local slope, the
 // wind and the orientation of the front (extended conormal n_Σ of the context).
 #include "balbi.hpp"
+#include "barriers.hpp"
 #include "fire_maps.hpp"
 
 #include <bodyfit/clock_time.hpp>
 #include <bodyfit/config.hpp>
+#include <bodyfit/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/map.hpp>
@@ -125,8 +127,14 @@ class FireModel final : public VelocityModel {
         {"perimeters.file", "\"perimeters.gpkg\"", "the burnt region's outline at every perimeters.every-th state "
                                                    "and the last (.gpkg or .geojson; \"\": none)"},
         {"perimeters.every", "1", "a perimeter every this many iterations"},
+        {"barriers.file", "", "roads, rivers, fuel breaks, lakes: lines and polygons of a vector layer (GeoJSON, "
+                              "Shapefile, GeoPackage) where R = 0 within max(width/2, 2 × the longest edge)"},
+        {"barriers.layer", "(the first)", "the layer of barriers.file"},
+        {"barriers.width", "0", "width of the barriers, m (narrower than the mesh: they act with its width)"},
     };
   }
+
+  void set_surface(const SurfaceSource& source) override { surface_ = source; }
 
   void configure(const toml::table& table) override {
     Parameters p(table, "model");
@@ -163,8 +171,8 @@ class FireModel final : public VelocityModel {
           throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
         wind_u_file_ = w.path("u_file");
         wind_v_file_ = w.path("v_file");
-        wind_.u = read_dem(wind_u_file_);
-        wind_.v = read_dem(wind_v_file_);
+        wind_.u = read_model_raster(wind_u_file_, Resampling::bilinear);
+        wind_.v = read_model_raster(wind_v_file_, Resampling::bilinear);
         // A wind grid has no holes: its NODATA cells take the nearest valid value.
         for (auto [grid, file] : {std::pair{&wind_.u, &wind_u_file_}, std::pair{&wind_.v, &wind_v_file_}})
           if (const std::size_t filled = fill_nodata(*grid))
@@ -208,7 +216,7 @@ class FireModel final : public VelocityModel {
       }
       fuel_file_ = map;
       if (!map.empty()) {
-        fuel_map_ = read_dem(map);
+        fuel_map_ = read_model_raster(map, Resampling::nearest);
         check_fuel_codes();
       }
       f.reject_unknown();
@@ -218,7 +226,7 @@ class FireModel final : public VelocityModel {
       arrival_cell_ = a.number("cell_size", 0, {.min = 0});
       const std::filesystem::path like = a.path("like");
       arrival_like_file_ = like;
-      if (!like.empty()) arrival_like_ = read_dem(like);
+      if (!like.empty()) arrival_like_ = read_model_raster(like, Resampling::bilinear);
       arrival_format_ = a.choice("format", arrival_format_, {"tif", "asc"});
       a.reject_unknown();
     }
@@ -228,13 +236,26 @@ class FireModel final : public VelocityModel {
       perimeter_every_ = int(q.integer("every", perimeter_every_, 1));
       q.reject_unknown();
     }
-    // The rasters of one case share one coordinate system, which the outputs then carry.
+    if (const toml::table* barriers = p.table("barriers")) {
+      Parameters b(*barriers, "model.barriers");
+      BarrierOptions options;
+      options.file = b.path("file");
+      options.layer = b.string("layer", "");
+      options.width = b.number("width", 0, {.min = 0});
+      b.reject_unknown();
+      if (options.file.empty()) throw InputError("[model.barriers] file: expected a vector layer of barriers");
+      barriers_ = Barriers::read(options, surface_);
+    } else {
+      barriers_ = Barriers();
+    }
+    // The rasters of one case share one coordinate system, the surface's when it has one (each
+    // raster was checked against it as it was read), which the outputs then carry.
     std::vector<std::pair<const HeightGrid*, std::filesystem::path>> rasters;
     if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
     if (wind_.u.cols > 0) rasters.emplace_back(&wind_.u, wind_u_file_);
     if (wind_.v.cols > 0) rasters.emplace_back(&wind_.v, wind_v_file_);
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
-    crs_.clear();
+    crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
     std::filesystem::path first_file;
     for (const auto& [grid, file] : rasters) {
@@ -243,7 +264,7 @@ class FireModel final : public VelocityModel {
       else {
         first = grid;
         first_file = file;
-        crs_ = grid->crs;
+        if (crs_.empty()) crs_ = grid->crs;
       }
     }
     p.reject_unknown();
@@ -261,7 +282,14 @@ class FireModel final : public VelocityModel {
     if (context.is_terrain() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
 
     ScalarField speed(mesh.n_vertices(), 0.0);
+    const std::span<const int> active = context.active_vertices();
+    if (!barriers_.empty()) {
+      // The band's sub-steps work on the mesh of the state's own compute (T^n): its longest edge.
+      if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
+      mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
+    }
     auto rate_at = [&](int v) {
+      if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
       const Vec3& x = mesh.point(VertexHandle(v));
       const BalbiParameters* fuel = fuel_at(x);
       if (!fuel) return 0.0;  // not burnable: the front stops here
@@ -275,7 +303,7 @@ class FireModel final : public VelocityModel {
       return rate_of_spread(std::atan(tan_gamma), *fuel);
     };
     // A sub-step in a narrow band needs R at the band's vertices only, and no metrics or fields.
-    if (const std::span<const int> active = context.active_vertices(); !active.empty()) {
+    if (!active.empty()) {
       if (rates_.size() != mesh.n_vertices()) rates_.assign(mesh.n_vertices(), 0.0);
       for (int v : active) speed[v] = rates_[std::size_t(v)] = rate_at(v);
       return VelocityField::normal(std::move(speed));
@@ -432,6 +460,21 @@ class FireModel final : public VelocityModel {
     write_polygon_layer(output_dir / perimeter_file_, layer);
   }
 
+  // A raster of the model in the surface's coordinate system: one in the DEM's own system when the
+  // case reprojected the DEM is warped like it (`resampling`: nearest for codes), one in another
+  // system is an InputError naming both files, one without a system is taken as the surface's.
+  HeightGrid read_model_raster(const std::filesystem::path& file, Resampling resampling) const {
+    DemReadOptions options;
+    if (!surface_.reprojected_from.empty())
+      options = {.reproject = Reprojection::utm, .target_crs = surface_.crs, .resampling = resampling};
+    HeightGrid grid = read_dem(file, options);
+    if (grid.crs.empty() && !surface_.crs.empty())
+      spdlog::warn("{}: no coordinate system: its cells are taken as in the surface's ({})", file.string(),
+                   crs_label(surface_.crs, surface_.dem));
+    require_crs(grid.crs, file, surface_.crs, surface_.dem);
+    return grid;
+  }
+
   bool non_burnable(long long code) const {
     return code == 0 || std::find(non_burnable_.begin(), non_burnable_.end(), code) != non_burnable_.end();
   }
@@ -462,6 +505,10 @@ class FireModel final : public VelocityModel {
     return &fuels_[std::size_t(code) - 1];
   }
 
+  SurfaceSource surface_;  ///< what S was built from (set_surface): its CRS is the case's
+  Barriers barriers_;
+  double barrier_reach_ = 0;   ///< of the state's own compute (barrier_reach)
+  std::vector<char> stopped_;  ///< 1 at the vertices a barrier blocks
   BalbiParameters base_;
   std::vector<BalbiParameters> fuels_;
   std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA

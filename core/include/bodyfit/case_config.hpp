@@ -133,6 +133,9 @@ CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::s
 
 /// The surface S of the case (generated or read), without region labels.
 SurfaceMesh make_case_surface(const CaseConfig& config);
+/// What S is built from, for the model (VelocityModel::set_surface): the DEM, its coordinate system
+/// and, when the case reprojects it, the one it had (reads the DEM; empty without one).
+SurfaceSource case_surface_source(const CaseConfig& config);
 /// The initial level set of the case on the vertices of `surface` (negative inside G(0)), or an
 /// empty field when the region comes from face refs (RegionSpec::Kind::Refs).
 ScalarField initial_level_set(const CaseConfig& config, const SurfaceMesh& surface);

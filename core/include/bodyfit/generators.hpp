@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace bodyfit {
@@ -60,8 +61,17 @@ enum class Reprojection {
   none,  ///< refuse it, naming the UTM zone to project it to
   utm,   ///< warp it to the WGS 84 / UTM zone of its centre (GDAL's warper, bilinear, NODATA kept)
 };
+/// How a warped raster takes its values from the source's cells.
+enum class Resampling {
+  bilinear,  ///< heights, wind components
+  nearest,   ///< codes (fuel classes): no value that is in no source cell
+};
 struct DemReadOptions {
   Reprojection reproject = Reprojection::none;
+  /// With reproject = utm: the projected system to warp to (WKT with an EPSG code, e.g. that of the
+  /// case's surface), instead of the UTM zone of the raster's centre.
+  std::string target_crs{};
+  Resampling resampling = Resampling::bilinear;
 };
 
 /// ESRI ASCII grid (.asc) as a terrain: NODATA kept, some data and plausible heights required.
@@ -76,6 +86,13 @@ HeightGrid read_geotiff(const std::filesystem::path& file);
 /// Dispatch on extension (.asc, .tif/.tiff); NODATA cells are kept as they are (a raster whose
 /// cells are all NODATA is an error). A geographic raster is refused, or reprojected on request.
 HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options = {});
+/// The coordinate system of the terrain read_dem(file, options) makes (WKT, "" when unknown), and
+/// the raster's own when read_dem reprojects it ("" otherwise).
+struct DemCoordinates {
+  std::string crs{};
+  std::string reprojected_from{};
+};
+DemCoordinates dem_coordinates(const std::filesystem::path& file, const DemReadOptions& options = {});
 /// An InputError naming both files when two rasters of one case have different coordinate systems
 /// (an unknown one, "", matches any).
 void require_same_crs(const HeightGrid& a, const std::filesystem::path& file_a, const HeightGrid& b,

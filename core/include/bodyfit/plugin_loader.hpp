@@ -57,10 +57,11 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures = nu
 /// contains a '/' or ends in .so.
 LoadedModel load_model(std::string_view name);
 LoadedModel load_plugin_file(const std::filesystem::path& file);
-/// Call model.configure(parameters). An InputError (the documented way to refuse a parameter)
-/// becomes InputError "<file>: configure failed: <reason>"; any other exception PluginError
-/// "<file>: model '<name>' failed in configure: <reason>".
-void configure_model(LoadedModel& model, const toml::table& parameters);
+/// Call model.set_surface(surface) (plugins built for ABI ≥ 2.4 only: older ones have no such
+/// entry in their vtable), then model.configure(parameters). An InputError (the documented way to
+/// refuse a parameter) becomes InputError "<file>: configure failed: <reason>"; any other exception
+/// PluginError "<file>: model '<name>' failed in configure: <reason>".
+void configure_model(LoadedModel& model, const toml::table& parameters, const SurfaceSource& surface = {});
 /// Decode kPluginAbi-style numbers: "1.0".
 std::string abi_string(std::uint32_t abi);
 

@@ -30,10 +30,10 @@ struct VectorLayer {
   std::vector<VectorFeature> features{};
 };
 
-/// The first layer of a vector file (any format OGR reads: .geojson, .shp, .gpkg…). Curves are
-/// linearised, z is dropped. Throws InputError naming the file when OGR cannot read it or bodyfit
-/// was built without GDAL.
-VectorLayer read_vector_layer(const std::filesystem::path& file);
+/// A layer of a vector file (any format OGR reads: .geojson, .shp, .gpkg…): the one named `name`,
+/// or the first ("" ). Curves are linearised, z is dropped. Throws InputError naming the file when
+/// OGR cannot read it, it has no such layer, or bodyfit was built without GDAL.
+VectorLayer read_vector_layer(const std::filesystem::path& file, const std::string& name = "");
 
 /// Write a layer of polygons (each feature a MultiPolygon; every feature has the attributes of the
 /// first, in its order and types) as a GeoPackage (.gpkg) or GeoJSON (.geojson/.json), with its

@@ -34,7 +34,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 3;
+inline constexpr std::uint32_t kPluginAbiMinor = 4;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// One parameter a model accepts, for `bodyfit plugins` and for error messages.
@@ -70,6 +70,16 @@ struct VelocityField {
     f.normal_speed = std::move(v);
     return f;
   }
+};
+
+/// What the surface S was built from (ABI 2.4; VelocityModel::set_surface): a model's own rasters
+/// and layers are checked against it, and its outputs carry its coordinate system.
+struct SurfaceSource {
+  std::filesystem::path dem{};  ///< the DEM of a terrain ("" when S is not made from one)
+  std::string crs{};            ///< the system of S's coordinates (WKT; "" when unknown)
+  /// The DEM file's own system when the case reprojected it to `crs` ([surface] reproject =
+  /// "utm"); "" when S is in the DEM's own system.
+  std::string reprojected_from{};
 };
 
 /// Where and when a StepContext made outside a run stands (StepContext::standalone).
@@ -221,6 +231,9 @@ class VelocityModel {
   /// settings (both formats of a raster, its default names): `bodyfit run --overwrite` removes
   /// them with the driver's own, so a replaced run leaves none of the previous run's files.
   virtual std::vector<std::string> output_files() const { return {}; }
+  /// (ABI 2.4) What S was built from, given once before configure() (configure_model passes it;
+  /// plugins built for an older ABI are not asked). Default: ignored.
+  virtual void set_surface(const SurfaceSource& /*source*/) {}
 };
 
 }  // namespace bodyfit
