@@ -429,6 +429,9 @@ class FireModel final : public VelocityModel {
     };
     for (const auto& p : perimeters_) add(p);
     if (latest_) add(*latest_);
+    // The GeoPackage's own stamp (last_change): the clock time of its latest perimeter, or the
+    // epoch without [time] start; never the time of writing, so a resumed run writes the same bytes.
+    if (clock_start_) layer.timestamp = *clock_start_ + (latest_ ? latest_->time : perimeters_.back().time);
     write_polygon_layer(output_dir / perimeter_file_, layer);
   }
 
