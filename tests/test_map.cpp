@@ -315,3 +315,63 @@ TEST_CASE("bodyfit map: a run directory (final mesh, arrival times, ignitions), 
   CHECK_FALSE(fs::exists(dir / "none.png"));
   CHECK_FALSE(fs::exists(dir / "small.png"));
 }
+
+TEST_CASE("map at a time: the burnt fill is the arrival raster's cells reached by then, not the final G") {
+  if constexpr (!config::have_cairo) return;
+  test::TempDir dir("map_at");
+  const SurfaceMesh mesh = burnt_terrain();  // G: the disk of 2 km
+  MapLayers layers;
+  layers.arrival = radial_arrival();           // the front 1.5 km out at 30 min
+  layers.burnt_at = 1800;
+  MapOptions options;
+  draw_fire_map(dir / "map.png", mesh, layers, options);
+  const Image image = read_png(dir / "map.png");
+  const MapLayout layout = layout_of(mesh, options);
+  const std::vector<char> cells = burnt_cells(layers.arrival, 1800);
+  const HeightGrid& grid = layers.arrival;
+  // Every cell centre of the southern half (the labels sit north), off the centre's star and the
+  // corners' scale bar, and over a cell from the front (its outline and the 30 min isochrone):
+  // reddish exactly where the cell is reached by 30 min.
+  std::size_t burnt = 0, checked = 0, wrong = 0;
+  for (std::size_t row = 0; row < grid.rows; ++row)
+    for (std::size_t col = 0; col < grid.cols; ++col) {
+      const double x = grid.x_origin + (double(col) + 0.5) * grid.cell_size;
+      const double y = grid.y_origin + (double(grid.rows - 1 - row) + 0.5) * grid.cell_size;
+      const double r = std::hypot(x - kCentre, y - kCentre);
+      if (y > kCentre - 300 || r < 300 || r > 3500 || std::abs(r - 1500) < 1.5 * grid.cell_size) continue;
+      const bool reached = cells[row * grid.cols + col];
+      CHECK(reached == (grid.at(row, col) <= 1800));
+      const Rgb c = pixel_at(image, layout, x, y);
+      const bool grey = std::abs(int(c[0]) - int(c[1])) < 10 && std::abs(int(c[1]) - int(c[2])) < 10;
+      wrong += reached ? !reddish(c) : !grey;
+      burnt += reached;
+      ++checked;
+    }
+  CHECK(burnt > 300);                 // the half disk of 1.5 km: ≈ 1400 cells of 50 m
+  CHECK(checked - burnt > 1000);      // and the ring beyond it, inside the final G up to 2 km
+  CHECK(wrong == 0);
+  // Without a time, the final G: the ring from 1.6 to 1.9 km south is burnt again.
+  layers.burnt_at.reset();
+  draw_fire_map(dir / "final.png", mesh, layers, options);
+  CHECK(reddish(pixel_at(read_png(dir / "final.png"), layout, kCentre, kCentre - 1750)));
+  CHECK_FALSE(reddish(pixel_at(image, layout, kCentre, kCentre - 1750)));
+
+  // bodyfit map --at and --every on a run directory.
+  fs::create_directories(dir / "run");
+  write_mesh(mesh, dir / "run" / "final.mesh");
+  write_esri_ascii(dir / "run" / "arrival_time.asc", layers.arrival);
+  auto at = test::run_bodyfit(fmt::format("map {} -o {} --at 1800", (dir / "run").string(), (dir / "at.png").string()));
+  REQUIRE_MESSAGE(at.exit_code == 0, at.output);
+  CHECK(test::read_file(dir / "at.png") == test::read_file(dir / "map.png"));  // the picture drawn above
+  // The latest arrival is at the corners, 5 √2 km / (0.83 m/s) ≈ 2.36 h: maps at 1, 2 and 3 h.
+  auto every = test::run_bodyfit(fmt::format("map {} -o {} --every 3600", (dir / "run").string(), (dir / "m.png").string()));
+  REQUIRE_MESSAGE(every.exit_code == 0, every.output);
+  for (const char* name : {"m_003600s.png", "m_007200s.png", "m_010800s.png"}) CHECK(fs::exists(dir / name));
+  CHECK_FALSE(fs::exists(dir / "m_014400s.png"));
+  fs::remove(dir / "run" / "arrival_time.asc");
+  auto none = test::run_bodyfit(fmt::format("map {} -o {} --at 60", (dir / "run").string(), (dir / "none.png").string()));
+  CHECK(none.exit_code == 1);
+  CHECK(none.output.find("arrival times") != std::string::npos);
+  CHECK(test::run_bodyfit(fmt::format("map {} -o {} --at -5", (dir / "run").string(), (dir / "none.png").string()))
+            .exit_code == 2);
+}

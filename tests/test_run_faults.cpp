@@ -23,8 +23,8 @@ namespace {
 
 // A fire on a small procedural terrain, 5 steps of which the last is shortened (200 s of 600),
 // every output on: a VTU per state, a checkpoint per iteration, the arrival-time and rate rasters
-// (ESRI grids) and the perimeters (GeoJSON: text a byte comparison can hold, where a GeoPackage
-// records the time it was written).
+// (ESRI grids) and the perimeters (GeoJSON; a resumed run's GeoTIFFs and GeoPackage are compared
+// byte for byte in test_fire_wind.cpp).
 const char* kFire = R"(
 [surface]
 generator = "terrain"

@@ -12,8 +12,10 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <thread>
 #include <variant>
 
 using namespace bodyfit;
@@ -115,6 +117,33 @@ TEST_CASE("write_polygon_layer: a GeoPackage and a GeoJSON read back by OGR with
     }
     CHECK(std::abs(layer_feature_area(back.features[0]) - mesh_area) <= 1e-9 * mesh_area);
   }
+}
+
+TEST_CASE("write_polygon_layer: the same layer written a second later gives the same bytes (GeoPackage stamp)") {
+  if constexpr (!config::have_gdal) return;
+  VectorLayer layer{.name = "perimeters", .crs = kUtm32};
+  VectorFeature f;
+  f.geometry.polygons = region_outline(three_parts());
+  f.attributes = {{"iteration", std::int64_t(1)}, {"time", 60.0}};
+  layer.features.push_back(std::move(f));
+  test::TempDir dir("vector_io_stamp");
+  for (const char* extension : {".gpkg", ".geojson"}) {
+    CAPTURE(extension);
+    const auto first = dir / (std::string("first") + extension), second = dir / (std::string("second") + extension);
+    write_polygon_layer(first, layer);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+    write_polygon_layer(second, layer);
+    const std::string bytes = test::read_file(first);
+    CHECK(bytes.size() > 0);
+    CHECK(bytes == test::read_file(second));
+  }
+  // The stamp a GeoPackage carries (gpkg_contents.last_change): the epoch, or the layer's timestamp.
+  CHECK(test::read_file(dir / "first.gpkg").find("1970-01-01T00:00:00.000Z") != std::string::npos);
+  layer.timestamp = 1784034000.0;  // 2026-07-14T13:00:00Z
+  write_polygon_layer(dir / "stamped.gpkg", layer);
+  const std::string stamped = test::read_file(dir / "stamped.gpkg");
+  CHECK(stamped.find("2026-07-14T13:00:00.000Z") != std::string::npos);
+  CHECK(stamped.find("1970-01-01T00:00:00.000Z") == std::string::npos);
 }
 
 TEST_CASE("read_vector_layer: points, lines, polygons with holes and multi-parts from GeoJSON, errors name the file") {

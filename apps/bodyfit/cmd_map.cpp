@@ -1,6 +1,8 @@
 // bodyfit map RUN_DIR|MESH [--arrival arrival_time.tif|.asc] -o map.png: a fire map (map.hpp) of a
-// finished run or of a mesh with its regions: hillshade, burnt area, isochrones, scale bar, legend.
+// finished run or of a mesh with its regions: hillshade, burnt area, isochrones, scale bar, legend;
+// with --at T (or --every S) the burnt area at that time, from the arrival raster.
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
@@ -11,7 +13,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <optional>
 #include <memory>
 
 namespace {
@@ -22,7 +27,13 @@ using namespace bodyfit;
 struct MapArguments {
   std::string input, output, arrival, title = "Fire map", size = "1200x900", crs, datetime, time_unit = "auto";
   double interval_minutes = 0, sun_azimuth = 315, sun_altitude = 45, z_factor = 1;
+  std::optional<double> at, every;  ///< seconds after t = 0
 };
+
+/// The maps of --every S: `map.png` → `map_001800s.png`, … (zero-padded: they sort by time).
+fs::path map_at_time(const fs::path& output, double time) {
+  return output.parent_path() / fmt::format("{}_{:06.0f}s{}", output.stem().string(), time, output.extension().string());
+}
 
 int map_command(const MapArguments& args) {
   MapOptions options;
@@ -51,6 +62,29 @@ int map_command(const MapArguments& args) {
   }
   if (!args.crs.empty()) run.layers.crs_name = args.crs;
   run.layers.datetime = args.datetime;
+  if (args.at || args.every) {
+    if (run.layers.arrival.cols == 0)
+      throw InputError(fmt::format("{}: --at and --every draw the burnt area from the arrival times, and there are none "
+                                   "(a run on a terrain writes arrival_time.tif; or give --arrival)",
+                                   args.input));
+    if (args.at && args.every) throw InputError("give --at or --every, not both");
+  }
+  if (args.every) {
+    // Every multiple of S up to the latest arrival, that time included.
+    double latest = 0;
+    for (double t : run.layers.arrival.heights)
+      if (std::isfinite(t) && t != run.layers.arrival.nodata) latest = std::max(latest, t);
+    const long count = long(std::ceil(latest / *args.every - 1e-9));
+    if (count > 1000) throw InputError(fmt::format("--every {}: {} maps up to {} s; at most 1000", *args.every, count, latest));
+    for (long k = 1; k <= std::max(1L, count); ++k) {
+      run.layers.burnt_at = double(k) * *args.every;
+      draw_fire_map(map_at_time(args.output, *run.layers.burnt_at), run.mesh, run.layers, options);
+    }
+    spdlog::info("{}: {} maps, every {} s, -> {}", args.input, std::max(1L, count), *args.every,
+                 map_at_time(args.output, *args.every).string());
+    return 0;
+  }
+  run.layers.burnt_at = args.at;
   draw_fire_map(args.output, run.mesh, run.layers, options);
   spdlog::info("{}: {}x{} map of {} faces, {} -> {}", args.input, w, h, run.mesh.n_faces(),
                run.layers.arrival.cols ? "with isochrones" : "no arrival times", args.output);
@@ -78,6 +112,11 @@ bodyfit::cli::Command setup_map(CLI::App& app) {
   cmd->add_option("--z-factor", args->z_factor, "hillshade relief exaggeration (heights times this)")
       ->capture_default_str();
   cmd->add_option("--crs", args->crs, "coordinate system name for the caption (default: from the .prj)");
+  cmd->add_option("--at", args->at, "the burnt area at this time, s after t = 0: the arrival raster's cells reached by then")
+      ->check(bodyfit::cli::finite_at_least(0));
+  cmd->add_option("--every", args->every,
+                  "one map per multiple of this time (s) up to the last arrival, named map_001800s.png after -o map.png")
+      ->check(bodyfit::cli::finite_above(0));
   cmd->add_option("--datetime", args->datetime, "date and time for the caption, e.g. \"2026-07-14 16:00 UTC\"");
   return {cmd, [args]() { return map_command(*args); }};
 }

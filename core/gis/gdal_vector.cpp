@@ -9,7 +9,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <bodyfit/clock_time.hpp>
+
+#include <cmath>
 #include <cstdlib>
+#include <optional>
+#include <string>
 #include <variant>
 
 namespace bodyfit::gis {
@@ -172,6 +177,33 @@ bool read_vector(const std::filesystem::path& file, const std::string& name, Vec
   return true;
 }
 
+namespace {
+
+/// The date-time a GeoPackage stamps on its contents (gpkg_contents.last_change, in the standard's
+/// %Y-%m-%dT%H:%M:%fZ form), taken from the layer, not from the machine's clock: GDAL's GPKG
+/// driver uses OGR_CURRENT_DATE, when set, instead of "now". Set for this thread while the file
+/// is written, and put back as it was after.
+class DeterministicDate {
+ public:
+  explicit DeterministicDate(std::optional<double> timestamp) {
+    if (const char* before = CPLGetThreadLocalConfigOption("OGR_CURRENT_DATE", nullptr)) before_ = before;
+    double whole = std::floor(timestamp.value_or(0.0));
+    long milliseconds = std::lround((timestamp.value_or(0.0) - whole) * 1000);
+    if (milliseconds == 1000) whole += 1, milliseconds = 0;
+    std::string date = format_iso8601(whole);  // "…:SSZ"
+    date.insert(date.size() - 1, fmt::format(".{:03d}", milliseconds));
+    CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", date.c_str());
+  }
+  ~DeterministicDate() { CPLSetThreadLocalConfigOption("OGR_CURRENT_DATE", before_ ? before_->c_str() : nullptr); }
+  DeterministicDate(const DeterministicDate&) = delete;
+  DeterministicDate& operator=(const DeterministicDate&) = delete;
+
+ private:
+  std::optional<std::string> before_;
+};
+
+}  // namespace
+
 bool write_polygons(const std::filesystem::path& file, const std::string& driver_name, const VectorLayer& layer,
                     std::string& error) {
   GDALAllRegister();
@@ -205,6 +237,7 @@ bool write_polygons(const std::filesystem::path& file, const std::string& driver
     error = fmt::format("{} (GDAL: {})", what, CPLGetLastErrorMsg());
     return false;
   };
+  const DeterministicDate date(layer.timestamp);
   GDALDatasetH dataset = GDALCreate(driver, file.c_str(), 0, 0, 0, GDT_Unknown, nullptr);
   if (!dataset) return gdal_failure("cannot create the file");
   DatasetCloser closer{dataset};

@@ -243,8 +243,49 @@ void draw_north_arrow(cairo_t* cr, const MapLayout& layout, const Fonts& fonts) 
   draw_text(cr, x - text_width(cr, "N") / 2, y - size - 4, "N");
 }
 
-void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, bool burnt, const std::vector<double>& levels,
+// The burnt area at a time (MapLayers::burnt_at): the raster's cells reached by then, filled as one
+// path (one coat of the colour), outlined where a burnt cell meets an unburnt one or the edge.
+void draw_burnt_cells(cairo_t* cr, const HeightGrid& arrival, const std::vector<char>& cells, const MapLayout& layout,
+                      const MapOptions& options) {
+  const auto burnt = [&](long row, long col) {
+    return row >= 0 && col >= 0 && std::size_t(row) < arrival.rows && std::size_t(col) < arrival.cols &&
+           cells[std::size_t(row) * arrival.cols + std::size_t(col)];
+  };
+  // Corner (i, j) of the cell grid: i columns east of the west edge, j rows south of the north edge.
+  const auto corner = [&](std::size_t i, std::size_t j) {
+    return layout.to_pixel(arrival.x_origin + double(i) * arrival.cell_size,
+                           arrival.y_origin + double(arrival.rows - j) * arrival.cell_size);
+  };
+  for (std::size_t row = 0; row < arrival.rows; ++row)
+    for (std::size_t col = 0; col < arrival.cols; ++col)
+      if (burnt(long(row), long(col))) {
+        const MapPixel a = corner(col, row), b = corner(col + 1, row + 1);
+        cairo_rectangle(cr, a.x, a.y, b.x - a.x, b.y - a.y);
+      }
+  set_colour(cr, options.burnt_color, options.burnt_opacity);
+  cairo_fill(cr);
+  const auto edge = [&](MapPixel a, MapPixel b) {
+    cairo_move_to(cr, a.x, a.y);
+    cairo_line_to(cr, b.x, b.y);
+  };
+  for (std::size_t row = 0; row < arrival.rows; ++row)
+    for (std::size_t col = 0; col < arrival.cols; ++col) {
+      const long r = long(row), c = long(col);
+      if (!burnt(r, c)) continue;
+      if (!burnt(r - 1, c)) edge(corner(col, row), corner(col + 1, row));
+      if (!burnt(r + 1, c)) edge(corner(col, row + 1), corner(col + 1, row + 1));
+      if (!burnt(r, c - 1)) edge(corner(col, row), corner(col, row + 1));
+      if (!burnt(r, c + 1)) edge(corner(col + 1, row), corner(col + 1, row + 1));
+    }
+  cairo_set_source_rgb(cr, 0.45, 0, 0);
+  cairo_set_line_width(cr, 1.5);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  cairo_stroke(cr);
+}
+
+void draw_legend(cairo_t* cr, const MapLayers& layers, double burnt_area, const std::vector<double>& levels,
                  const MapLayout& layout, const MapOptions& options, const Fonts& fonts) {
+  const bool burnt = burnt_area > 0;
   const double x = layout.legend_left + 10, swatch = 1.6 * fonts.body, line = 1.7 * fonts.body;
   double y = layout.panel_top + fonts.body;
   const double bottom = layout.height - 2 * fonts.body;
@@ -261,7 +302,10 @@ void draw_legend(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, 
     set_colour(cr, options.burnt_color, options.burnt_opacity);
     cairo_rectangle(cr, x, y - swatch / 3, swatch, 2 * swatch / 3);
     cairo_fill(cr);
-    text_at(swatch + 8, fmt::format("Burnt area, {:.3g} km\u00b2", region_area(mesh, kInside) / 1e6));
+    const std::string when =
+        layers.burnt_at ? " at " + time_label(*layers.burnt_at, isochrone_interval(layers.arrival, options), options)
+                        : "";
+    text_at(swatch + 8, fmt::format("Burnt area{}, {:.3g} km\u00b2", when, burnt_area / 1e6));
     y += line;
     cairo_move_to(cr, x, y);
     cairo_line_to(cr, x + swatch, y);
@@ -351,7 +395,16 @@ void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const M
   const MapLayout layout = map_layout(xmin, ymin, xmax, ymax, options);
   const Fonts fonts{std::clamp(0.032 * options.height, 16.0, 40.0), std::clamp(0.019 * options.height, 11.0, 24.0),
                     std::clamp(0.016 * options.height, 10.0, 20.0)};
-  const std::vector<double> levels = isochrone_levels(layers.arrival, options);
+  std::vector<double> levels = isochrone_levels(layers.arrival, options);
+  std::vector<char> cells;  // the burnt area at layers.burnt_at: the raster's cells reached by then
+  double burnt_area = 0;
+  if (layers.burnt_at) {
+    std::erase_if(levels, [&](double level) { return level > *layers.burnt_at; });
+    cells = burnt_cells(layers.arrival, *layers.burnt_at);
+    burnt_area = double(std::count(cells.begin(), cells.end(), 1)) * layers.arrival.cell_size * layers.arrival.cell_size;
+  } else if (mesh.has_regions() && any_burnt(mesh)) {
+    burnt_area = region_area(mesh, kInside);
+  }
 
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
@@ -360,8 +413,9 @@ void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const M
                   layout.panel_bottom - layout.panel_top);
   cairo_clip(cr);
   draw_hillshade(cr, mesh, layout, options);
-  const bool burnt = layers.burnt_area && mesh.has_regions() && any_burnt(mesh);
-  if (burnt) draw_burnt_area(cr, mesh, layout, options);
+  if (!layers.burnt_area) burnt_area = 0;
+  if (burnt_area > 0 && layers.burnt_at) draw_burnt_cells(cr, layers.arrival, cells, layout, options);
+  else if (burnt_area > 0) draw_burnt_area(cr, mesh, layout, options);
   if (!levels.empty()) draw_isochrones(cr, layers, levels, layout, options, fonts);
   for (const Vec3& p : layers.ignitions) draw_star(cr, layout.to_pixel(p[0], p[1]), 9, options.ignition_color);
   cairo_restore(cr);
@@ -373,7 +427,7 @@ void draw(cairo_t* cr, const SurfaceMesh& mesh, const MapLayers& layers, const M
   cairo_stroke(cr);
   draw_scale_bar(cr, layout, fonts);
   draw_north_arrow(cr, layout, fonts);
-  draw_legend(cr, mesh, layers, burnt, levels, layout, options, fonts);
+  draw_legend(cr, layers, burnt_area, levels, layout, options, fonts);
   draw_title_and_caption(cr, layers, layout, options, fonts);
 }
 

@@ -57,6 +57,13 @@ double interval_for(const HeightGrid& arrival, const MapOptions& options, double
 
 }  // namespace
 
+std::vector<char> burnt_cells(const HeightGrid& arrival, double time) {
+  std::vector<char> cells(arrival.heights.size(), 0);
+  for (std::size_t i = 0; i < cells.size(); ++i)
+    cells[i] = reached(arrival.heights[i], arrival.nodata) && arrival.heights[i] <= time;
+  return cells;
+}
+
 double nice_step_below(double value) {
   if (!(value > 0) || !std::isfinite(value)) throw InputError(fmt::format("nice_step_below: {} is not a positive length", value));
   const double decade = std::pow(10.0, std::floor(std::log10(value)));

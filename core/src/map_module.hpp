@@ -11,7 +11,7 @@
 
 namespace bodyfit::map_module {
 
-inline constexpr std::uint32_t kApiVersion = 1;
+inline constexpr std::uint32_t kApiVersion = 2;  // 2: MapLayers::burnt_at
 
 /// The module's entry points.
 struct Api {

@@ -78,13 +78,6 @@ double raster_nearest(const HeightGrid& grid, double x, double y) {
   return grid.at(grid.rows - 1 - std::size_t(row_from_south), std::size_t(col));
 }
 
-Vec3 WindField::at(const Vec3& x) const {
-  if (type == "uniform") return uniform;
-  if (type == "rotating") return scale * Vec3(x[1] - center[1], -(x[0] - center[0]), 0);
-  if (type == "grid") return Vec3(u.sample(x[0], x[1]), v.sample(x[0], x[1]), 0);
-  return Vec3(0, 0, 0);
-}
-
 void ArrivalRaster::initialise(const SurfaceMesh& mesh, double cell_size, const HeightGrid& like, double mesh_size) {
   if (like.cols > 0) {
     grid_ = like;

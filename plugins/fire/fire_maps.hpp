@@ -1,5 +1,5 @@
 #pragma once
-// Spatial data of the fire model: wind fields, raster lookups and the arrival-time raster.
+// Spatial data of the fire model: raster lookups and the arrival-time raster (the wind: wind.hpp).
 #include <bodyfit/generators.hpp>
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/model_state.hpp>
@@ -14,17 +14,6 @@ namespace bodyfit::fire {
 
 /// Value of the cell containing (x, y) (clamped to the raster).
 double raster_nearest(const HeightGrid& grid, double x, double y);
-
-/// Horizontal wind U(x) in m/s.
-struct WindField {
-  std::string type = "none";  ///< none | uniform | rotating | grid
-  Vec3 uniform{0, 0, 0};
-  Vec3 center{0, 0, 0};
-  bool has_center = false;
-  double scale = 1e-3;        ///< rotating: U = scale·(y − yc, −(x − xc), 0)
-  HeightGrid u, v;            ///< grid: components on rasters
-  Vec3 at(const Vec3& x) const;
-};
 
 /// Arrival time of the front on a fixed raster, interpolated within each step: a cell centre that
 /// is outside G at t^n (d > 0) and inside at t^n + Δt (φ^{n+1} ≤ 0) is reached at

@@ -4,6 +4,7 @@
 #include "balbi.hpp"
 #include "barriers.hpp"
 #include "fire_maps.hpp"
+#include "wind.hpp"
 
 #include <bodyfit/clock_time.hpp>
 #include <bodyfit/config.hpp>
@@ -110,13 +111,16 @@ class FireModel final : public VelocityModel {
         {"u0", "39.8", "combustion gas velocity, m/s"},
         {"v0", "12*R0", "flame-base velocity, m/s"},
         {"max_tilt_deg", "80", "cap on the tilt angle γ, degrees (< 90)"},
-        {"wind.type", "\"none\"", "none | uniform | rotating | grid"},
+        {"wind.type", "\"none\"", "none | uniform | rotating | grid | series | grid_series"},
         {"wind.velocity", "[0, 0]", "uniform wind (x, y), m/s"},
         {"wind.speed, wind.direction_deg", "", "uniform wind as speed (m/s) and the direction it blows from (degrees "
                                                "clockwise from north), instead of velocity"},
         {"wind.center", "(domain centre)", "rotating wind centre (x, y), m: U = scale·(y − yc, −(x − xc), 0)"},
         {"wind.scale", "0.001", "rotating wind angular rate, 1/s (m/s of wind per m from the centre)"},
         {"wind.u_file, wind.v_file", "", "gridded wind components, ESRI ASCII grids (m/s)"},
+        {"wind.file", "", "series: CSV time,speed,direction_deg or time,u,v; grid_series: CSV time,u_file,v_file "
+                          "(rasters relative to it); times in s after t = 0 or ISO 8601 ([time] start); linear "
+                          "in time on (u, v), the end values held outside"},
         {"fuel.map", "", "raster of fuel codes: k ≥ 1 = fuel.presets[k−1]; 0, NODATA and fuel.non_burnable do not burn"},
         {"fuel.presets", "[preset]", "parameter sets of the codes of fuel.map"},
         {"fuel.non_burnable", "[]", "more codes of fuel.map that do not burn (water, rock, e.g. [98, 99])"},
@@ -147,43 +151,10 @@ class FireModel final : public VelocityModel {
     base_.v0 = p.number("v0", 12 * base_.R0, {.min = 0, .min_exclusive = true});
     base_.max_tilt = p.number("max_tilt_deg", 80, {.min = 0, .max = 90, .min_exclusive = true, .max_exclusive = true}) * kDegree;
 
-    if (const toml::table* wind = p.table("wind")) {
-      Parameters w(*wind, "model.wind");
-      wind_.type = w.choice("type", "none", {"none", "uniform", "rotating", "grid"});
-      auto velocity = w.numbers("velocity", {0, 0}, 2);
-      wind_.uniform = Vec3(velocity[0], velocity[1], 0);
-      // Or as a weather report gives it (what an ensemble samples): the speed and the direction
-      // the wind blows from, clockwise from north (a wind from 270° blows towards +x).
-      if (w.has("speed") || w.has("direction_deg")) {
-        if (wind_.type != "uniform") w.fail("speed", "speed and direction_deg apply to type = \"uniform\"");
-        if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
-        const double speed = w.required_number("speed", {.min = 0});
-        const double from = w.required_number("direction_deg") * kDegree;
-        wind_.uniform = Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
-      }
-      auto center = w.numbers("center", {}, std::nullopt);
-      if (!center.empty() && center.size() != 2) throw InputError("[model.wind] center: expected [x, y]");
-      wind_.has_center = !center.empty();
-      if (wind_.has_center) wind_.center = Vec3(center[0], center[1], 0);
-      wind_.scale = w.number("scale", 1e-3);
-      if (wind_.type == "grid") {
-        if (!w.has("u_file") || !w.has("v_file"))
-          throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
-        wind_u_file_ = w.path("u_file");
-        wind_v_file_ = w.path("v_file");
-        wind_.u = read_model_raster(wind_u_file_, Resampling::bilinear);
-        wind_.v = read_model_raster(wind_v_file_, Resampling::bilinear);
-        // A wind grid has no holes: its NODATA cells take the nearest valid value.
-        for (auto [grid, file] : {std::pair{&wind_.u, &wind_u_file_}, std::pair{&wind_.v, &wind_v_file_}})
-          if (const std::size_t filled = fill_nodata(*grid))
-            spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid wind", file->string(), filled,
-                         grid->heights.size());
-      } else {
-        w.accept("u_file");
-        w.accept("v_file");
-      }
-      w.reject_unknown();
-    }
+    if (const toml::table* wind = p.table("wind"))
+      wind_ = read_wind_table(*wind, [&](const std::filesystem::path& file) {
+        return read_model_raster(file, Resampling::bilinear);
+      });
     if (const toml::table* fuel = p.table("fuel")) {
       Parameters f(*fuel, "model.fuel");
       const std::filesystem::path map = f.path("map");
@@ -252,8 +223,7 @@ class FireModel final : public VelocityModel {
     // raster was checked against it as it was read), which the outputs then carry.
     std::vector<std::pair<const HeightGrid*, std::filesystem::path>> rasters;
     if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
-    if (wind_.u.cols > 0) rasters.emplace_back(&wind_.u, wind_u_file_);
-    if (wind_.v.cols > 0) rasters.emplace_back(&wind_.v, wind_v_file_);
+    for (const auto& raster : wind_.rasters()) rasters.push_back(raster);
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
@@ -279,6 +249,9 @@ class FireModel final : public VelocityModel {
       wind_.center = 0.5 * (box.min + box.max);
       wind_.has_center = true;
     }
+    // A wind series is a function of time: V at the time of this (sub-)step (docs/fire.md, "Wind").
+    wind_.set_clock(context.clock_start());
+    const double time = context.time();
     if (context.is_terrain() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
 
     ScalarField speed(mesh.n_vertices(), 0.0);
@@ -298,7 +271,7 @@ class FireModel final : public VelocityModel {
       const Vec3& normal = normals[v];
       // ∇_S s · n_Σ = e3 · n_Σ because n_Σ is tangent (∇_S s = e3 − (e3·N)N).
       double slope_term = n_sigma[2];
-      double wind_term = OpenMesh::dot(wind_.at(x), n_sigma);
+      double wind_term = OpenMesh::dot(wind_.at(x, time), n_sigma);
       double tan_gamma = tan_tilt(slope_term, std::abs(normal[2]), wind_term, *fuel);
       return rate_of_spread(std::atan(tan_gamma), *fuel);
     };
@@ -457,6 +430,9 @@ class FireModel final : public VelocityModel {
     };
     for (const auto& p : perimeters_) add(p);
     if (latest_) add(*latest_);
+    // The GeoPackage's own stamp (last_change): the clock time of its latest perimeter, or the
+    // epoch without [time] start; never the time of writing, so a resumed run writes the same bytes.
+    if (clock_start_) layer.timestamp = *clock_start_ + (latest_ ? latest_->time : perimeters_.back().time);
     write_polygon_layer(output_dir / perimeter_file_, layer);
   }
 
@@ -517,7 +493,7 @@ class FireModel final : public VelocityModel {
   double arrival_cell_ = 0;
   HeightGrid arrival_like_;
   std::string crs_;
-  std::filesystem::path fuel_file_, wind_u_file_, wind_v_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
+  std::filesystem::path fuel_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
   ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
   std::string arrival_format_ = config::have_gdal ? "tif" : "asc";

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,10 @@ struct MapLayers {
   std::vector<Vec3> ignitions;  ///< points (x, y) marked with a star
   std::string crs_name;         ///< e.g. "WGS 84 / UTM zone 32N", shown in the caption
   std::string datetime;         ///< e.g. "2026-07-14 16:00 UTC", shown in the caption
+  /// The burnt area at this time (s after t = 0; `bodyfit map --at`): the cells of `arrival`
+  /// reached at or before it are filled and outlined instead of G's faces, and only the isochrones
+  /// up to it are drawn. None: G of the mesh (the final state).
+  std::optional<double> burnt_at;
 };
 
 enum class TimeUnit { automatic, hours, minutes };
@@ -95,6 +100,10 @@ Rgb isochrone_colour(std::size_t index, std::size_t count);
 /// The contour t = level of a raster (cell centres, marching squares with linear interpolation;
 /// NaN or NODATA cells break the line), as world segments.
 std::vector<std::array<Vec3, 2>> isochrone_segments(const HeightGrid& arrival, double level);
+
+/// The cells of `arrival` reached at or before `time` (1) or not (0), in the raster's order (row 0
+/// north); NaN and NODATA cells never are.
+std::vector<char> burnt_cells(const HeightGrid& arrival, double time);
 
 /// Draw the map as a PNG (written atomically). InputError for options out of range (size, sun
 /// altitude in [0, 90], opacity in [0, 1], negative interval, z factor ≤ 0), and when bodyfit was built without

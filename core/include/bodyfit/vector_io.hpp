@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -28,6 +29,10 @@ struct VectorLayer {
   std::string name{};  ///< the layer's name (a GeoPackage's table)
   std::string crs{};   ///< WKT ("" when unknown)
   std::vector<VectorFeature> features{};
+  /// Written: the time a GeoPackage records as its last change (gpkg_contents.last_change), s since
+  /// 1970-01-01T00:00:00Z; none: that epoch itself. Never the clock of the writing machine, so the
+  /// same layer gives the same bytes (a resumed run's file equals an uninterrupted run's).
+  std::optional<double> timestamp{};
 };
 
 /// A layer of a vector file (any format OGR reads: .geojson, .shp, .gpkg…): the one named `name`,

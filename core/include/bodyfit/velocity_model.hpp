@@ -108,7 +108,9 @@ class StepContext {
 
   const SurfaceMesh& mesh() const;     ///< T^n: regions (f:region), interface (e:interface)
   const ScalarField& distance() const; ///< signed geodesic distance d_{G^n}, < 0 inside
-  double time() const;                 ///< t^n
+  /// t^n; in a CFL sub-step after the first, the sub-step's own start (t^n + the time advanced):
+  /// a model whose V depends on time (a wind series) evaluates it there.
+  double time() const;
   double dt() const;                   ///< Δt of this step
   int iteration() const;               ///< n
   double mesh_size() const;            ///< mean edge length h of T^n

@@ -1,0 +1,310 @@
+#include "wind.hpp"
+
+#include <bodyfit/clock_time.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/parameters.hpp>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string_view>
+#include <tuple>
+
+namespace bodyfit::fire {
+namespace {
+
+constexpr double kDegree = M_PI / 180.0;
+
+/// A weather report's wind: its speed and the direction it blows from, clockwise from north (a
+/// wind from 270° blows towards +x).
+Vec3 wind_from_direction(double speed, double direction_deg) {
+  const double from = direction_deg * kDegree;
+  return Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+struct CsvRow {
+  long line = 0;
+  std::vector<std::string> fields;
+};
+
+/// A CSV with a header line: comma-separated fields, surrounding blanks trimmed; blank lines and
+/// lines starting with '#' skipped.
+struct Csv {
+  std::filesystem::path file{};
+  long header_line = 0;
+  std::vector<std::string> columns{};
+  std::vector<CsvRow> rows{};
+
+  /// The column's index, or columns.size() when absent.
+  std::size_t column(std::string_view name) const {
+    return std::size_t(std::find(columns.begin(), columns.end(), name) - columns.begin());
+  }
+  bool has(std::string_view name) const { return column(name) < columns.size(); }
+};
+
+std::vector<std::string> split_fields(std::string_view text) {
+  std::vector<std::string> fields;
+  while (true) {
+    const std::size_t comma = text.find(',');
+    fields.emplace_back(trim(text.substr(0, comma)));
+    if (comma == std::string_view::npos) return fields;
+    text.remove_prefix(comma + 1);
+  }
+}
+
+Csv read_csv(const std::filesystem::path& file, std::string_view expected) {
+  std::ifstream in(file);
+  if (!in) throw file_error(file, fmt::format("cannot open the wind series (expected a CSV file: {})", expected));
+  Csv csv{.file = file};
+  std::string text;
+  for (long line = 1; std::getline(in, text); ++line) {
+    std::string_view view = text;
+    if (line == 1 && view.starts_with("\xEF\xBB\xBF")) view.remove_prefix(3);  // a spreadsheet's BOM
+    view = trim(view);
+    if (view.empty() || view.front() == '#') continue;
+    std::vector<std::string> fields = split_fields(view);
+    if (csv.columns.empty()) {
+      for (const auto& name : fields)
+        if (name.empty() || std::count(fields.begin(), fields.end(), name) > 1)
+          throw file_error(file, line, fmt::format("the header '{}' has an empty or repeated column name (expected {})",
+                                                   view, expected));
+      csv.columns = std::move(fields);
+      csv.header_line = line;
+      continue;
+    }
+    if (fields.size() != csv.columns.size())
+      throw file_error(file, line, fmt::format("{} field(s), the header has {} ({})", fields.size(), csv.columns.size(),
+                                               fmt::join(csv.columns, ",")));
+    csv.rows.push_back({line, std::move(fields)});
+  }
+  if (csv.columns.empty()) throw file_error(file, fmt::format("no header line (expected {})", expected));
+  if (csv.rows.empty()) throw file_error(file, csv.header_line, "no row after the header: expected one row per time");
+  return csv;
+}
+
+/// The columns must be exactly `required` (in any order).
+void require_columns(const Csv& csv, const std::vector<std::string_view>& required, std::string_view expected) {
+  for (const auto& name : csv.columns)
+    if (std::find(required.begin(), required.end(), name) == required.end())
+      throw file_error(csv.file, csv.header_line, fmt::format("unknown column '{}' (expected {})", name, expected));
+  for (std::string_view name : required)
+    if (!csv.has(name))
+      throw file_error(csv.file, csv.header_line, fmt::format("no column '{}' (expected {})", name, expected));
+}
+
+double finite_number(const Csv& csv, const CsvRow& row, std::string_view column) {
+  std::string_view text = row.fields[csv.column(column)];
+  if (text.starts_with('+')) text.remove_prefix(1);
+  double value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc() || end != text.data() + text.size() || text.empty())
+    throw file_error(csv.file, row.line, fmt::format("{}: '{}' is not a number", column, row.fields[csv.column(column)]));
+  if (!std::isfinite(value))
+    throw file_error(csv.file, row.line, fmt::format("{}: {} is not a finite number", column, text));
+  return value;
+}
+
+/// The times of the rows: seconds after t = 0, or ISO 8601 date-times (seconds since the epoch),
+/// all of one kind, strictly increasing.
+void read_times(const Csv& csv, WindSeries& series) {
+  for (std::size_t k = 0; k < csv.rows.size(); ++k) {
+    const CsvRow& row = csv.rows[k];
+    const std::string& text = row.fields[csv.column("time")];
+    double time = 0;
+    bool clock = false;
+    if (const std::optional<double> date = parse_iso8601(text)) {
+      time = *date;
+      clock = true;
+    } else {
+      try {
+        time = finite_number(csv, row, "time");
+      } catch (const InputError&) {
+        throw file_error(csv.file, row.line,
+                         fmt::format("time: '{}' is neither a number of seconds after t = 0 nor an ISO 8601 date-time "
+                                     "with its zone (2026-07-14T13:00:00Z)",
+                                     text));
+      }
+    }
+    if (k == 0) series.clock_times = clock;
+    if (clock != series.clock_times)
+      throw file_error(csv.file, row.line,
+                       fmt::format("time: '{}' is {}, the first time is {}: give every time the same way", text,
+                                   clock ? "a date-time" : "in seconds", clock ? "in seconds" : "a date-time"));
+    if (k > 0 && !(time > series.times.back()))
+      throw file_error(csv.file, row.line,
+                       fmt::format("time {} is not after the previous row's (line {}): times must increase", text,
+                                   csv.rows[k - 1].line));
+    series.times.push_back(time);
+  }
+}
+
+bool same_frame(const HeightGrid& a, const HeightGrid& b) {
+  return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
+         a.cell_size == b.cell_size;
+}
+
+/// A wind raster: its NODATA cells take the nearest valid value (a wind field has no holes).
+HeightGrid read_wind_raster(const std::filesystem::path& file, const RasterReader& read) {
+  HeightGrid grid = read ? read(file) : read_dem(file);
+  if (const std::size_t filled = fill_nodata(grid))
+    spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid wind", file.string(), filled,
+                 grid.heights.size());
+  return grid;
+}
+
+}  // namespace
+
+WindSeries read_wind_series(const std::filesystem::path& file) {
+  constexpr std::string_view expected = "time,speed,direction_deg or time,u,v";
+  const Csv csv = read_csv(file, expected);
+  const bool components = csv.has("u") || csv.has("v");
+  if (components) require_columns(csv, {"time", "u", "v"}, expected);
+  else require_columns(csv, {"time", "speed", "direction_deg"}, expected);
+  WindSeries series{.file = file};
+  read_times(csv, series);
+  for (const CsvRow& row : csv.rows) {
+    if (components) {
+      series.uniform.emplace_back(finite_number(csv, row, "u"), finite_number(csv, row, "v"), 0);
+    } else {
+      const double speed = finite_number(csv, row, "speed");
+      if (speed < 0) throw file_error(file, row.line, fmt::format("speed: {} is negative (m/s, expected ≥ 0)", speed));
+      series.uniform.push_back(wind_from_direction(speed, finite_number(csv, row, "direction_deg")));
+    }
+  }
+  return series;
+}
+
+WindSeries read_wind_grid_series(const std::filesystem::path& file, const RasterReader& read) {
+  constexpr std::string_view expected = "time,u_file,v_file";
+  const Csv csv = read_csv(file, expected);
+  require_columns(csv, {"time", "u_file", "v_file"}, expected);
+  WindSeries series{.file = file};
+  read_times(csv, series);
+  for (const CsvRow& row : csv.rows) {
+    for (auto [column, grids, files] : {std::tuple{"u_file", &series.u, &series.u_files},
+                                        std::tuple{"v_file", &series.v, &series.v_files}}) {
+      const std::string& name = row.fields[csv.column(column)];
+      if (name.empty()) throw file_error(file, row.line, fmt::format("{}: empty (expected a raster's file name)", column));
+      const std::filesystem::path raster = (file.parent_path() / name).lexically_normal();
+      try {
+        grids->push_back(read_wind_raster(raster, read));
+      } catch (const InputError& e) {
+        throw file_error(file, row.line, fmt::format("{}: {}", column, e.what()));
+      }
+      files->push_back(raster);
+      const HeightGrid& first = series.u.front();
+      const HeightGrid& grid = grids->back();
+      if (!same_frame(first, grid))
+        throw file_error(file, row.line,
+                         fmt::format("{}: {} is {}×{} cells of {} m from ({}, {}), {} is {}×{} of {} m from ({}, {}): the "
+                                     "rasters of a grid series share one frame",
+                                     column, raster.string(), grid.cols, grid.rows, grid.cell_size, grid.x_origin,
+                                     grid.y_origin, series.u_files.front().string(), first.cols, first.rows,
+                                     first.cell_size, first.x_origin, first.y_origin));
+      require_same_crs(first, series.u_files.front(), grid, raster);
+    }
+  }
+  return series;
+}
+
+TimeBracket bracket_time(const std::vector<double>& times, double t) {
+  if (times.empty() || t <= times.front()) return {};
+  if (t >= times.back()) return {times.size() - 1, times.size() - 1, 0};
+  const std::size_t next = std::size_t(std::upper_bound(times.begin(), times.end(), t) - times.begin());
+  const std::size_t index = next - 1;
+  return {index, next, (t - times[index]) / (times[next] - times[index])};
+}
+
+void WindField::set_clock(std::optional<double> clock_start) {
+  if (on_clock_ || series.times.empty()) return;
+  if (series.clock_times && !clock_start)
+    throw file_error(series.file, "its times are ISO 8601 date-times: the case needs [time] start (the date-time of "
+                                  "t = 0), or give the times in seconds after t = 0");
+  run_times_ = series.times;
+  if (series.clock_times)
+    for (double& t : run_times_) t -= *clock_start;
+  on_clock_ = true;
+}
+
+Vec3 WindField::at(const Vec3& x, double t) const {
+  if (type == "uniform") return uniform;
+  if (type == "rotating") return scale * Vec3(x[1] - center[1], -(x[0] - center[0]), 0);
+  if (type == "grid") return Vec3(u.sample(x[0], x[1]), v.sample(x[0], x[1]), 0);
+  if (type == "series" || type == "grid_series") {
+    if (!on_clock_) throw std::logic_error("WindField::at: the series is not on the run's clock (set_clock)");
+    // a + w·(b − a): exactly a where the two ends are equal (a constant series is a uniform wind).
+    const TimeBracket b = bracket_time(run_times_, t);
+    if (type == "series") return series.uniform[b.index] + b.weight * (series.uniform[b.next] - series.uniform[b.index]);
+    const double u0 = series.u[b.index].sample(x[0], x[1]), v0 = series.v[b.index].sample(x[0], x[1]);
+    if (b.next == b.index) return Vec3(u0, v0, 0);
+    const double u1 = series.u[b.next].sample(x[0], x[1]), v1 = series.v[b.next].sample(x[0], x[1]);
+    return Vec3(u0 + b.weight * (u1 - u0), v0 + b.weight * (v1 - v0), 0);
+  }
+  return Vec3(0, 0, 0);
+}
+
+std::vector<std::pair<const HeightGrid*, std::filesystem::path>> WindField::rasters() const {
+  std::vector<std::pair<const HeightGrid*, std::filesystem::path>> list;
+  if (u.cols > 0) list.emplace_back(&u, u_file);
+  if (v.cols > 0) list.emplace_back(&v, v_file);
+  if (!series.u.empty()) list.emplace_back(&series.u.front(), series.u_files.front());  // all share its system
+  return list;
+}
+
+WindField read_wind_table(const toml::table& table, const RasterReader& read) {
+  Parameters w(table, "model.wind");
+  WindField wind;
+  wind.type = w.choice("type", "none", {"none", "uniform", "rotating", "grid", "series", "grid_series"});
+  auto velocity = w.numbers("velocity", {0, 0}, 2);
+  wind.uniform = Vec3(velocity[0], velocity[1], 0);
+  // Or as a weather report gives it (what an ensemble samples).
+  if (w.has("speed") || w.has("direction_deg")) {
+    if (wind.type != "uniform") w.fail("speed", "speed and direction_deg apply to type = \"uniform\"");
+    if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
+    const double speed = w.required_number("speed", {.min = 0});
+    wind.uniform = wind_from_direction(speed, w.required_number("direction_deg"));
+  }
+  auto center = w.numbers("center", {}, std::nullopt);
+  if (!center.empty() && center.size() != 2) throw InputError("[model.wind] center: expected [x, y]");
+  wind.has_center = !center.empty();
+  if (wind.has_center) wind.center = Vec3(center[0], center[1], 0);
+  wind.scale = w.number("scale", 1e-3);
+  if (wind.type == "grid") {
+    if (!w.has("u_file") || !w.has("v_file"))
+      throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
+    wind.u_file = w.path("u_file");
+    wind.v_file = w.path("v_file");
+    wind.u = read_wind_raster(wind.u_file, read);
+    wind.v = read_wind_raster(wind.v_file, read);
+  } else {
+    w.accept("u_file");
+    w.accept("v_file");
+  }
+  if (wind.type == "series" || wind.type == "grid_series") {
+    if (!w.has("file"))
+      w.fail(fmt::format("type = \"{}\" needs file = \"wind.csv\" ({})", wind.type,
+                         wind.type == "series" ? "time,speed,direction_deg or time,u,v" : "time,u_file,v_file"));
+    const std::filesystem::path file = w.path("file");
+    wind.series = wind.type == "series" ? read_wind_series(file) : read_wind_grid_series(file, read);
+    if (!wind.series.clock_times) wind.set_clock(std::nullopt);
+  } else {
+    w.forbid({"file"}, fmt::format("to type \"{}\" (a wind series is type = \"series\" or \"grid_series\")", wind.type));
+    w.accept("file");
+  }
+  w.reject_unknown();
+  return wind;
+}
+
+}  // namespace bodyfit::fire
