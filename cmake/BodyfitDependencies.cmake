@@ -26,16 +26,20 @@ if(TETGEN_INCLUDE_DIR AND TETGEN_LIBRARY)
   target_compile_definitions(bodyfit::tetgen INTERFACE TETLIBRARY)
 endif()
 
-# GDAL is optional: GeoTIFF DEMs are read through it when present.
+# GDAL is required (the GIS formats: GeoTIFF rasters, coordinate systems, reprojection, vector
+# layers; loaded as a module on first use, never linked into the core). -DBODYFIT_WITH_GDAL=OFF
+# builds without those formats on purpose.
 set(BODYFIT_HAVE_GDAL OFF)
 if(BODYFIT_WITH_GDAL)
   find_package(GDAL CONFIG QUIET)
   if(NOT GDAL_FOUND)
     find_package(GDAL QUIET)
   endif()
-  if(GDAL_FOUND)
-    set(BODYFIT_HAVE_GDAL ON)
+  if(NOT GDAL_FOUND)
+    message(FATAL_ERROR "bodyfit: GDAL not found (Debian: apt-get install libgdal-dev, which scripts/setup.sh "
+                        "does); or configure with -DBODYFIT_WITH_GDAL=OFF to build without the GIS formats")
   endif()
+  set(BODYFIT_HAVE_GDAL ON)
 endif()
 message(STATUS "bodyfit: GeoTIFF support through GDAL: ${BODYFIT_HAVE_GDAL}")
 
