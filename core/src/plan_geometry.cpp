@@ -7,17 +7,17 @@
 namespace bodyfit {
 namespace {
 
-double segment_distance(const PlanPoint& a, const PlanPoint& b, double x, double y) {
+PlanPoint plan(const Vec3& p) { return {p[0], p[1]}; }
+
+}  // namespace
+
+double distance_to_segment(const PlanPoint& a, const PlanPoint& b, double x, double y) {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
   const double length2 = dx * dx + dy * dy;
   double t = length2 > 0 ? ((x - a[0]) * dx + (y - a[1]) * dy) / length2 : 0;
   t = std::clamp(t, 0.0, 1.0);
   return std::hypot(x - (a[0] + t * dx), y - (a[1] + t * dy));
 }
-
-PlanPoint plan(const Vec3& p) { return {p[0], p[1]}; }
-
-}  // namespace
 
 double signed_ring_area(const PlanPath& ring) {
   if (ring.empty()) return 0;
@@ -72,7 +72,7 @@ double distance_to_path(const PlanPath& path, double x, double y, bool closed) {
   double d = std::numeric_limits<double>::infinity();
   const std::size_t n = path.size();
   for (std::size_t i = 0; i + 1 < n + (closed ? 1 : 0); ++i)
-    d = std::min(d, segment_distance(path[i], path[(i + 1) % n], x, y));
+    d = std::min(d, distance_to_segment(path[i], path[(i + 1) % n], x, y));
   return d;
 }
 

@@ -14,14 +14,6 @@
 namespace bodyfit::fire {
 namespace {
 
-double distance_to_segment(const PlanPoint& a, const PlanPoint& b, double x, double y) {
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  const double length2 = dx * dx + dy * dy;
-  double t = length2 > 0 ? ((x - a[0]) * dx + (y - a[1]) * dy) / length2 : 0.0;
-  t = std::clamp(t, 0.0, 1.0);
-  return std::hypot(x - (a[0] + t * dx), y - (a[1] + t * dy));
-}
-
 /// Every point of every geometry of the layer, in place (for a transformation in one call).
 std::vector<PlanPoint*> points_of(VectorLayer& layer) {
   std::vector<PlanPoint*> points;

@@ -36,6 +36,8 @@ double path_length(const PlanPath& path, bool closed);
 double polygon_perimeter(const PlanPolygon& polygon);
 /// Whether (x, y) is inside the ring (even-odd rule; points on the ring may go either way).
 bool inside_ring(const PlanPath& ring, double x, double y);
+/// Distance from (x, y) to the segment ab (a point when a = b).
+double distance_to_segment(const PlanPoint& a, const PlanPoint& b, double x, double y);
 /// Distance from (x, y) to a path (closed: to the ring). A single point is a path too.
 double distance_to_path(const PlanPath& path, double x, double y, bool closed);
 /// Signed distance to a polygon's boundary: negative inside (inside the outer ring, outside the holes).
