@@ -722,3 +722,48 @@ TEST_CASE("specks: parts of a region below speck_area·h² go to the region arou
     if (!inside_face) CHECK(mesh.phi(v) >= 0);
   }
 }
+
+TEST_CASE("specks: the threshold is the part's area, however far the search stops") {
+  // Two single-vertex islands of φ < 0 with linear crossings: each encloses t² times the star of
+  // its vertex, t = a / (a + b) the crossings' fraction. One is set just under speck_area·h², the
+  // other just over; a large disk is kept. The search of each part stops once its area reaches the
+  // threshold: stopping early or late moves a part to the wrong side of it.
+  const int n = 24;
+  SurfaceMesh mesh = make_square(n);
+  const double h = edge_length_stats(mesh).mean, threshold = 0.1 * h * h;
+  auto vertex_near = [&](double x, double y) {
+    VertexHandle best;
+    double best_d = 1e30;
+    for (auto v : mesh.vertices())
+      if (double d = (mesh.point(v) - Vec3(x, y, 0)).norm(); d < best_d) best_d = d, best = v;
+    return best;
+  };
+  const VertexHandle small = vertex_near(0.25, 0.75), large = vertex_near(0.75, 0.75);
+  auto star_area = [&](VertexHandle v) {
+    double area = 0;
+    for (auto f : mesh.vf_range(v)) area += face_area(mesh, f);
+    return area;
+  };
+  const double b = 1.0;  // φ at every other vertex near the islands
+  ScalarField phi(mesh.n_vertices(), b);
+  auto island = [&](VertexHandle v, double area) {
+    const double t = std::sqrt(area / star_area(v));  // a/(a+b) = t
+    phi[v.idx()] = -t * b / (1 - t);
+  };
+  island(small, 0.97 * threshold);
+  island(large, 1.03 * threshold);
+  for (auto v : mesh.vertices())  // and a disk of radius 0.2 around (0.5, 0.25)
+    if (double d = (mesh.point(v) - Vec3(0.5, 0.25, 0)).norm() - 0.2; d < 0.3) phi[v.idx()] = d;
+  const DiscretizeOptions linear{.hermite_crossings = false, .speck_area = 0.1};
+  SurfaceMesh kept = mesh;
+  discretize(kept, phi, {.hermite_crossings = false, .speck_area = 0});
+  REQUIRE(region_components(kept, kInside) == 3);
+  const auto report = discretize(mesh, phi, linear);
+  require_valid(mesh, strict(1, 1));
+  CHECK(report.removed_specks == 1);
+  CHECK(region_components(mesh, kInside) == 2);
+  // The part given away is the smaller one: the inside lost 0.97·threshold.
+  CHECK(region_area(kept, kInside) - region_area(mesh, kInside) == doctest::Approx(0.97 * threshold).epsilon(1e-6));
+  for (auto f : mesh.vf_range(large)) CHECK(mesh.region(f) == kInside);
+  for (auto f : mesh.vf_range(small)) CHECK(mesh.region(f) == kOutside);
+}

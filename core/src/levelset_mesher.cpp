@@ -254,64 +254,94 @@ bool improve_diagonal(SurfaceMesh& mesh, VertexHandle p, VertexHandle b, VertexH
 /// Give every part of a region with area below `min_area` to the region around it (smallest
 /// first; a part next to one given away in the same round waits for the next round, so that a
 /// speck's hole is judged after the speck is gone). Returns how many parts were given away.
-std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area) {
+///
+/// Local to the interface: every part of a region that is not a whole component of the surface
+/// has an interface edge, so the parts are grown from `seeds` (every face with a corner where
+/// φ = 0, which includes the faces on both sides of every interface edge), and a part's growth
+/// stops as soon as its area reaches `min_area`: the cost follows the interface, not the mesh.
+/// Giving a part away only removes interface edges, so the seeds of the first round serve all.
+std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area, std::vector<FaceHandle> seeds) {
+  constexpr int kUnseen = -1, kLarge = -2;  // mark of a face: a small part's id, or one of these
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  std::vector<int> mark(mesh.n_faces(), kUnseen);
+  std::vector<FaceHandle> touched, stack, part_faces;
   std::size_t removed = 0;
-  const int nf = int(mesh.n_faces());
-  std::vector<int> part(std::size_t(nf), -1);
   for (bool changed = true; changed;) {
     changed = false;
-    std::fill(part.begin(), part.end(), -1);
-    std::vector<double> area;
-    std::vector<FaceHandle> stack;
-    for (int i = 0; i < nf; ++i) {
-      if (part[std::size_t(i)] >= 0) continue;
-      const int id = int(area.size());
-      area.push_back(0);
-      part[std::size_t(i)] = id;
-      stack.push_back(FaceHandle(i));
-      while (!stack.empty()) {
+    for (auto f : touched) mark[std::size_t(f.idx())] = kUnseen;
+    touched.clear();
+    struct Part {
+      double area = 0;
+      std::vector<FaceHandle> faces;
+    };
+    std::vector<Part> parts;
+    for (auto seed : seeds) {
+      if (mark[std::size_t(seed.idx())] != kUnseen) continue;
+      const int id = int(parts.size());
+      const int region = mesh.region(seed);
+      double area = 0;
+      bool large = false;
+      part_faces.clear();
+      stack.assign(1, seed);
+      mark[std::size_t(seed.idx())] = id;
+      part_faces.push_back(seed);
+      while (!stack.empty() && !large) {
         auto f = stack.back();
         stack.pop_back();
-        area[std::size_t(id)] += face_area(mesh, f);
-        for (auto g : mesh.ff_range(f))
-          if (part[std::size_t(g.idx())] < 0 && mesh.region(g) == mesh.region(f)) {
-            part[std::size_t(g.idx())] = id;
-            stack.push_back(g);
-          }
+        area += face_area(mesh, f);
+        large = area >= min_area;
+        for (auto g : mesh.ff_range(f)) {
+          if (mesh.region(g) != region) continue;
+          int& m = mark[std::size_t(g.idx())];
+          if (m == kLarge) large = true;  // joined to a part already known to be large
+          if (m != kUnseen) continue;
+          m = id;
+          part_faces.push_back(g);
+          stack.push_back(g);
+        }
+      }
+      touched.insert(touched.end(), part_faces.begin(), part_faces.end());
+      if (large) {
+        for (auto f : part_faces) mark[std::size_t(f.idx())] = kLarge;
+      } else {
+        parts.push_back({area, part_faces});
       }
     }
-    std::vector<int> order;
-    for (int id = 0; id < int(area.size()); ++id)
-      if (area[std::size_t(id)] < min_area) order.push_back(id);
-    if (order.empty() || area.size() < 2) break;
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return area[std::size_t(a)] < area[std::size_t(b)]; });
-    std::vector<int> slot(area.size(), -1);  // small part -> its faces
-    std::vector<std::vector<FaceHandle>> faces(order.size());
-    for (std::size_t k = 0; k < order.size(); ++k) slot[std::size_t(order[k])] = int(k);
-    for (int i = 0; i < nf; ++i)
-      if (int k = slot[std::size_t(part[std::size_t(i)])]; k >= 0) faces[std::size_t(k)].push_back(FaceHandle(i));
-    std::vector<char> flipped(area.size(), 0), blocked(area.size(), 0);
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      if (blocked[std::size_t(order[k])]) continue;
-      flipped[std::size_t(order[k])] = 1;
-      for (auto f : faces[k])
-        for (auto g : mesh.ff_range(f)) blocked[std::size_t(part[std::size_t(g.idx())])] = 1;
+    if (parts.empty()) break;
+    std::vector<int> order(parts.size());
+    for (int id = 0; id < int(parts.size()); ++id) order[std::size_t(id)] = id;
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      return parts[std::size_t(a)].area < parts[std::size_t(b)].area ||
+             (parts[std::size_t(a)].area == parts[std::size_t(b)].area && a < b);
+    });
+    std::vector<char> blocked(parts.size(), 0);
+    std::vector<int> flipped;
+    for (int id : order) {
+      if (blocked[std::size_t(id)]) continue;
+      flipped.push_back(id);
+      for (auto f : parts[std::size_t(id)].faces)
+        for (auto g : mesh.ff_range(f))
+          if (int m = mark[std::size_t(g.idx())]; m >= 0) blocked[std::size_t(m)] = 1;
       ++removed;
       changed = true;
     }
-    for (int i = 0; i < nf; ++i) {
-      if (!flipped[std::size_t(part[std::size_t(i)])]) continue;
-      FaceHandle f(i);
-      const bool to_inside = mesh.region(f) != kInside;
-      mesh.region(f) = to_inside ? kInside : kOutside;
-      // φ takes the sign of its new side (its zeros become a hair off zero).
-      for (auto v : mesh.fv_range(f)) {
-        double& x = value[std::size_t(v.idx())];
-        double magnitude = std::max(std::abs(x), 1e-12 * std::sqrt(min_area));
-        bool all_same = true;
-        for (auto g : mesh.vf_range(v)) all_same = all_same && (mesh.region(g) == kInside) == to_inside;
-        if (all_same) x = to_inside ? -magnitude : magnitude;
-      }
+    for (int id : flipped) {
+      const bool to_inside = mesh.region(parts[std::size_t(id)].faces.front()) != kInside;
+      for (auto f : parts[std::size_t(id)].faces) mesh.region(f) = to_inside ? kInside : kOutside;
+    }
+    // φ takes the sign of its new side (its zeros become a hair off zero), once every part of the
+    // round has changed sides.
+    for (int id : flipped) {
+      const bool to_inside = mesh.region(parts[std::size_t(id)].faces.front()) == kInside;
+      for (auto f : parts[std::size_t(id)].faces)
+        for (auto v : mesh.fv_range(f)) {
+          double& x = value[std::size_t(v.idx())];
+          double magnitude = std::max(std::abs(x), 1e-12 * std::sqrt(min_area));
+          bool all_same = true;
+          for (auto g : mesh.vf_range(v)) all_same = all_same && (mesh.region(g) == kInside) == to_inside;
+          if (all_same) x = to_inside ? -magnitude : magnitude;
+        }
     }
   }
   return removed;
@@ -326,14 +356,22 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
                      std::to_string(mesh.n_vertices()) + " vertices");
   ScalarField value = phi;
   const double h_input = options.speck_area > 0 ? edge_length_stats(mesh).mean : 0;
-  for (auto v : mesh.vertices())
+  // Vertices that may end up on the level set: the input's zeros and the ends of crossed edges
+  // (snapped); the cut adds its new vertices. The faces around them are the speck search's seeds.
+  std::vector<VertexHandle> may_be_zero;
+  for (auto v : mesh.vertices()) {
     if (!std::isfinite(value[v.idx()]))
       throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
+    if (value[v.idx()] == 0) may_be_zero.push_back(v);
+  }
 
   // Crossed edges: the input's, less those a snap removed, plus those around separated vertices.
   std::vector<EdgeHandle> crossed;
   for (auto e : mesh.edges())
     if (crossed_edge(mesh, value, e)) crossed.push_back(e);
+  if (options.speck_area > 0)
+    for (auto e : crossed)
+      for (int side = 0; side < 2; ++side) may_be_zero.push_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)));
   snap(mesh, crossed, value, options, report);
   auto separated = separate_pinches(mesh, value, report);
   std::erase_if(crossed, [&](EdgeHandle e) { return !crossed_edge(mesh, value, e); });
@@ -434,7 +472,16 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
                   value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
   }
-  if (options.speck_area > 0) report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input);
+  if (options.speck_area > 0) {
+    std::vector<FaceHandle> seeds;
+    auto seed_around = [&](VertexHandle v) {
+      if (value[v.idx()] == 0)
+        for (auto f : mesh.vf_range(v)) seeds.push_back(f);
+    };
+    for (auto v : may_be_zero) seed_around(v);
+    for (int v = first_crossing; v < int(mesh.n_vertices()); ++v) seed_around(VertexHandle(v));
+    report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
+  }
   for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
   for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
 

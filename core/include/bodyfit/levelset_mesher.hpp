@@ -44,7 +44,9 @@ struct DiscretizeOptions {
   /// length of the input mesh) is given to the region around it, so its interface disappears.
   /// Such a part is below what the mesh resolves (a noise-born island of φ a fraction of one
   /// triangle across) and, as the remesher never changes the topology of the regions, it would pin
-  /// a cluster of poor triangles. 0 keeps every part.
+  /// a cluster of poor triangles. 0 keeps every part. The search grows parts from the interface and
+  /// stops at this area, so it costs in proportion to the interface; a whole component of S lying
+  /// in one region has no interface and is never a speck.
   double speck_area = 0.1;
 };
 
