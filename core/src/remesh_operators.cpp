@@ -258,11 +258,13 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h0));
   auto d = m_.to_vertex_handle(m_.next_halfedge_handle(h1));
   const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
-  auto t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
   change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+  // Only pairs with a poor triangle are worth changing in the passes: a good mesh stays as it is
+  // (decided before the new pair is computed: most pairs a pass looks at are good).
+  if (rule == Rule::Pass && change.old_min >= kFlipBelow) return false;
+  auto t0 = triangle(pa, pd, pc), t1 = triangle(pb, pc, pd);
   change.new_min = std::min(t0.quality, t1.quality);
-  // Only pairs with a poor triangle are worth changing in the passes: a good mesh stays as it is.
-  if (change.new_min <= change.old_min + 1e-3 || (rule == Rule::Pass && change.old_min >= kFlipBelow)) return false;
+  if (change.new_min <= change.old_min + 1e-3) return false;
   // No new edge above the split bound (unless no longer than the one it replaces).
   if (lengthens_beyond_split(c, d, (pd - pc).norm(), (pb - pa).norm())) return false;
   // The link condition (cd not already an edge) last: it walks a vertex ring.
