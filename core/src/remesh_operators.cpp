@@ -95,6 +95,24 @@ bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std
   std::vector<Vec3>& normals = normals_;
   normals.clear();
   for (const auto& t : triangles) normals.push_back(normal_of(t));
+  // The sides of the replaced faces with the face across each: a side of a new triangle that no
+  // other new triangle shares is one of them (read here instead of a find_halfedge per side).
+  struct Side {
+    VertexHandle from, to;
+    HalfedgeHandle across;
+  };
+  constexpr std::size_t kMaxSides = 3 * 64;
+  Side sides[kMaxSides];
+  std::size_t n_sides = 0;
+  for (auto f : replaced)
+    for (auto h : m_.fh_range(f))
+      if (n_sides < kMaxSides)
+        sides[n_sides++] = {m_.from_vertex_handle(h), m_.to_vertex_handle(h), m_.opposite_halfedge_handle(h)};
+  auto across = [&](VertexHandle u, VertexHandle w) -> HalfedgeHandle {
+    for (std::size_t i = 0; i < n_sides; ++i)
+      if (sides[i].from == u && sides[i].to == w) return sides[i].across;
+    return m_.find_halfedge(w, u);
+  };
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     if (normals[i].sqrnorm() == 0) continue;
     for (int k = 0; k < 3; ++k) {
@@ -111,7 +129,7 @@ bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std
           }
       if (!found) {
         if (!u.is_valid() || !w.is_valid()) continue;  // an edge of a vertex not yet in the mesh
-        auto h = m_.find_halfedge(w, u);
+        auto h = across(u, w);
         if (!h.is_valid() || m_.is_boundary(h)) continue;
         auto f = m_.face_handle(h);
         if (std::find(replaced.begin(), replaced.end(), f) != replaced.end()) continue;
@@ -386,9 +404,12 @@ bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Cha
     auto across = m_.opposite_halfedge_handle(spoke[i]);
     if (m_.is_boundary(across)) continue;
     auto next_spoke = m_.next_halfedge_handle(across);
-    for (int j = 0; j < n; ++j)
-      if (spoke[j] == next_spoke && moved_normal[j].sqrnorm() > 0 && (moved_normal[i] | moved_normal[j]) < kFoldCos)
-        return false;
+    // The circulator visits the spokes in that order: the next one is usually at i + 1.
+    int j = (i + 1) % n;
+    if (spoke[j] != next_spoke)
+      for (j = 0; j < n && spoke[j] != next_spoke; ++j) {
+      }
+    if (j < n && moved_normal[j].sqrnorm() > 0 && (moved_normal[i] | moved_normal[j]) < kFoldCos) return false;
   }
   return true;
 }
