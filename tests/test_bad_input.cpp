@@ -231,6 +231,8 @@ TEST_CASE("damaged, truncated or inconsistent files are input errors (exit 1) na
       {"remesh {d}/missing.mesh -o {d}/out.mesh", 1, "missing.mesh: cannot open", "out.mesh"},
       {"discretize " + kSphere + " --phi {d}/missing.sol -o {d}/out.mesh", 1, "missing.sol: cannot open", "out.mesh"},
       {"run {d}/missing.toml -o {d}/out", 1, "missing.toml: cannot open", "out"},
+      {"ensemble {d}/missing.toml -o {d}/out", 1, "missing.toml: cannot open", "out"},
+      {"map {d}/missing_run -o {d}/out.png", 1, "missing_run", "out.png"},
       {"render {d}/missing.mesh -o {d}/out.png", 1, "missing.mesh", "out.png"},
       {"plot {d}/missing.csv --column ms_total -o {d}/out.png", 1, "missing.csv", "out.png"},
   });

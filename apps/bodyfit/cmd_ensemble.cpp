@@ -109,9 +109,8 @@ bodyfit::cli::Command setup_ensemble(CLI::App& app) {
       "threads or MPI ranks (mpirun, srun), and reduce them into burn-probability and arrival-time rasters "
       "(docs/fire.md, \"Ensembles\")");
   auto args = std::make_shared<EnsembleArguments>();
-  cmd->add_option("case", args->case_file, "case file (.toml) with an [ensemble] table")
-      ->required()
-      ->check(CLI::ExistingFile);
+  // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
+  cmd->add_option("case", args->case_file, "case file (.toml) with an [ensemble] table")->required();
   cmd->add_option("-o,--output", args->output_dir, "output directory (default: <case name>.ensemble); run the same "
                                                    "command again to continue an interrupted ensemble");
   cmd->add_option("--set", args->sets, "override a key of the case, e.g. --set time.final_time=3600 (repeatable)");

@@ -336,7 +336,7 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
   return config;
 }
 
-CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+toml::table read_case_table(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   toml::table table;
   if (std::ifstream probe(file); !probe)  // toml++ would say "line 0: File could not be opened"
     throw file_error(file, fmt::format("cannot open for reading ({})", std::strerror(errno)));
@@ -346,6 +346,11 @@ CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::s
     throw file_error(file, long(e.source().begin.line), std::string(e.description()));
   }
   for (const auto& o : overrides) apply_override(table, o);
+  return table;
+}
+
+CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  toml::table table = read_case_table(file, overrides);
   try {
     CaseConfig config = parse_case(table, file.parent_path());
     config.file = file;

@@ -25,13 +25,7 @@ namespace fs = std::filesystem;
 /// The case an ensemble directory holds, as canonical text: the case file after the overrides,
 /// without the member count (a finished ensemble may be extended with more members).
 std::string ensemble_identity(const fs::path& case_file, const std::vector<std::string>& overrides) {
-  toml::table table;
-  try {
-    table = toml::parse_file(case_file.string());
-  } catch (const toml::parse_error& e) {
-    throw file_error(case_file, long(e.source().begin.line), std::string(e.description()));
-  }
-  for (const auto& o : overrides) apply_override(table, o);
+  toml::table table = read_case_table(case_file, overrides);
   if (toml::table* ensemble = table["ensemble"].as_table()) ensemble->erase("members");
   return canonical_case(table);
 }

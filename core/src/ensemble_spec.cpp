@@ -35,17 +35,6 @@ double uniform01(std::uint64_t seed, std::uint64_t index, std::uint64_t stream, 
   return double(ensemble_hash(seed, index, stream, draw) >> 11) * 0x1.0p-53;
 }
 
-toml::table read_case_table(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
-  toml::table table;
-  try {
-    table = toml::parse_file(file.string());
-  } catch (const toml::parse_error& e) {
-    throw file_error(file, long(e.source().begin.line), std::string(e.description()));
-  }
-  for (const auto& o : overrides) apply_override(table, o);
-  return table;
-}
-
 SampledParameter read_sampled(const std::string& key, const toml::node& node) {
   const std::string section = "ensemble.sample.\"" + key + "\"";
   const toml::table* t = node.as_table();

@@ -4,6 +4,7 @@
 #include "map_module.hpp"
 
 #include <bodyfit/atomic_file.hpp>
+#include <bodyfit/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/raster_io.hpp>
@@ -225,12 +226,7 @@ RunMap load_run_map(const std::filesystem::path& run_dir) {
       break;
     }
   if (const fs::path case_file = run_dir / "case.toml"; fs::exists(case_file)) {
-    toml::table table;
-    try {
-      table = toml::parse_file(case_file.string());
-    } catch (const toml::parse_error& e) {
-      throw file_error(case_file, long(e.source().begin.line), std::string(e.description()));
-    }
+    const toml::table table = read_case_table(case_file);
     if (table["region"]["shape"].value_or(std::string()) == "disks")
       if (const toml::array* centres = table["region"]["centers"].as_array())
         for (const toml::node& centre : *centres)

@@ -124,6 +124,9 @@ struct CaseConfig {
 /// (0.05, 12, true, "text", [1, 2]); anything that does not parse is taken as a string.
 void apply_override(toml::table& table, const std::string& assignment);
 
+/// Read a TOML file (a case, a run's case.toml) and apply the overrides in order, unvalidated.
+/// A missing file or a syntax error is an InputError naming the file (and the line).
+toml::table read_case_table(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 /// Validate a case table and turn it into a CaseConfig (throws InputError).
 CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir = {});
 /// Read a case file, apply the overrides in order, validate.
