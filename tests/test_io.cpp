@@ -1085,6 +1085,9 @@ TEST_CASE("bad OBJ and PLY files: each error names the file, its line (or byte) 
   continued.replace(continued.find("vt 1 0"), 6, "  1");
   m = read_error(dir, "continued.obj", continued.replace(continued.find("f 1 4"), 5, "f 1 44"));
   CHECK(contains(m, "continued.obj:18: face 1: vertex index 44"));
+  // An error inside a continued statement is reported at its first line.
+  m = read_error(dir, "inside.obj", with_line(18, "f 1 4 \\ # a comment after the backslash\n  3 99"));
+  CHECK(contains(m, "inside.obj:18: face 1: vertex index 99"));
   // The builder every reader shares: an unused vertex at its line.
   m = read_error(dir, "unused.obj", cube + "v 9 9 9\n");
   CHECK(contains(m, "unused.obj:24: vertex 9 is not a corner of any triangle"));

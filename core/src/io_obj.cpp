@@ -73,32 +73,10 @@ MeshRecords parse_obj(std::string_view bytes, const std::filesystem::path& file)
   std::vector<std::int64_t> corners;
   std::string joined;  // a statement continued over several lines ('\' at their ends)
   std::size_t faces = 0;
-  long number = 0;
-  for (std::size_t at = 0; at < bytes.size();) {
-    const std::size_t end = std::min(bytes.find('\n', at), bytes.size());
-    std::string_view line = bytes.substr(at, end - at);
-    at = end + 1;
-    const long line_number = ++number;
-    line = line.substr(0, line.find('#'));
-    while (!line.empty() && is_blank(line.back())) line.remove_suffix(1);
-    if (!line.empty() && line.back() == '\\') {
-      // Join the continued lines (each read once: bounded by the file).
-      joined.assign(line.substr(0, line.size() - 1));
-      while (at < bytes.size()) {
-        const std::size_t next_end = std::min(bytes.find('\n', at), bytes.size());
-        std::string_view next = bytes.substr(at, next_end - at);
-        at = next_end + 1;
-        ++number;
-        next = next.substr(0, next.find('#'));
-        while (!next.empty() && is_blank(next.back())) next.remove_suffix(1);
-        const bool continues = !next.empty() && next.back() == '\\';
-        joined += ' ';
-        joined.append(next.substr(0, next.size() - (continues ? 1 : 0)));
-        if (!continues) break;
-      }
-      line = joined;
-    }
-    Words words(line);
+  Lines lines(bytes);
+  while (const std::optional<std::string_view> line = lines.next_statement(joined)) {
+    const long line_number = lines.first_number();
+    Words words(*line);
     const std::string_view keyword = words.next();
     if (keyword.empty()) continue;
     if (keyword == "v") {

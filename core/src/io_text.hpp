@@ -23,22 +23,52 @@ class Lines {
   /// The next non-empty line (without its comment), or nullopt at the end.
   std::optional<std::string_view> next() {
     while (at_ < text_.size()) {
-      const std::size_t end = std::min(text_.find('\n', at_), text_.size());
-      std::string_view line = text_.substr(at_, end - at_);
-      at_ = end + 1;
-      ++number_;
-      line = line.substr(0, line.find('#'));
+      const std::string_view line = read_line();
       if (line.find_first_not_of(" \t\r\f\v") != std::string_view::npos) return line;
     }
     return std::nullopt;
   }
+  /// As next(), for a format whose statements go on over the following lines while a line ends
+  /// with '\' (OBJ): those lines are joined with spaces into `joined`, which the view returned then
+  /// points into; first_number() is the number of the statement's first line. Trailing blanks are
+  /// removed. Each line is read once, so a statement is bounded by the file.
+  std::optional<std::string_view> next_statement(std::string& joined) {
+    std::optional<std::string_view> line = next();
+    first_number_ = number_;
+    if (!line) return line;
+    const std::string_view text = trim_end(*line);
+    if (text.back() != '\\') return text;
+    joined.assign(text.substr(0, text.size() - 1));
+    while (at_ < text_.size()) {
+      const std::string_view more = trim_end(read_line());
+      const bool continues = !more.empty() && more.back() == '\\';
+      joined += ' ';
+      joined.append(more.substr(0, more.size() - (continues ? 1 : 0)));
+      if (!continues) break;
+    }
+    return std::string_view(joined);
+  }
   long number() const { return number_; }
+  long first_number() const { return first_number_; }
   std::size_t offset() const { return std::min(at_, text_.size()); }
 
  private:
+  /// The next line, without its comment (possibly empty).
+  std::string_view read_line() {
+    const std::size_t end = std::min(text_.find('\n', at_), text_.size());
+    std::string_view line = text_.substr(at_, end - at_);
+    at_ = end + 1;
+    ++number_;
+    return line.substr(0, line.find('#'));
+  }
+  static std::string_view trim_end(std::string_view line) {
+    while (!line.empty() && is_blank(line.back())) line.remove_suffix(1);
+    return line;
+  }
+
   std::string_view text_;
   std::size_t at_ = 0;
-  long number_ = 0;
+  long number_ = 0, first_number_ = 0;
 };
 
 /// Whitespace-separated words of one line.
