@@ -120,6 +120,9 @@ void check_same_case(const Checkpoint& c, const std::string& case_text, bool for
   for (const CaseChange& change : case_changes(c.case_text, case_text)) {
     const std::string text = fmt::format("{}: {} -> {}", change.key, shown(change.before), shown(change.after));
     if (resume_may_change(change.key)) spdlog::info("resuming with {}", text);
+    else if (is_input_digest(change.key) && change.before.empty())  // a checkpoint from before the digests
+      spdlog::info("the checkpoint records no digest of {} (written before checkpoints recorded them)",
+                   change.key.substr(change.key.find('.') + 1));
     else refused.push_back(text);
   }
   if (refused.empty()) return;
@@ -311,7 +314,9 @@ int run_case(const RunArguments& args) {
 
   // Set-up writes nothing: a bad case, model, mesh or checkpoint leaves the directory as it was.
   CaseConfig config = read_case(args.case_file, args.sets);
-  const std::string case_text = canonical_case(config.effective);
+  // The case and the files it names: a data file edited between a run and its --resume is another case.
+  const std::string case_text =
+      canonical_case(with_input_digests(config.effective, fs::path(args.case_file).parent_path()));
   const fs::path outdir =
       args.output_dir.empty() ? fs::path(fs::path(args.case_file).stem().string() + ".out") : fs::path(args.output_dir);
   const fs::path checkpoint = outdir / "checkpoint.bin";
