@@ -249,6 +249,25 @@ TEST_CASE("ensemble: a restart recomputes only the members whose results are mis
   CHECK(other.output.find("holds an ensemble of another case") != std::string::npos);
 }
 
+TEST_CASE("ensemble: a data file edited before a continuation is another case") {
+  // The wind as a series file: its digest is part of the ensemble's recorded case.
+  TempDir dir("ensemble_inputs");
+  std::string text = kCase;
+  const std::string uniform = "type = \"uniform\"\nspeed = 3.0\ndirection_deg = 250.0";
+  text.replace(text.find(uniform), uniform.size(), "type = \"series\"\nfile = \"wind.csv\"");
+  // The sampled wind keys do not exist with a series: sample R0 alone.
+  text.erase(text.find("\"model.wind.speed\""), text.find("\"model.R0\"") - text.find("\"model.wind.speed\""));
+  std::ofstream(dir / "wind.csv") << "time,speed,direction_deg\n0,3,250\n480,4,240\n";
+  const fs::path case_file = write_case(dir, text);
+  ensemble(case_file, dir / "run", "--members 2");
+  CHECK(read_file(dir / "run" / "ensemble_case.toml").find("model.wind.file") != std::string::npos);
+  ensemble(case_file, dir / "run", "--members 3");  // the same inputs: continued
+  std::ofstream(dir / "wind.csv") << "time,speed,direction_deg\n0,3,250\n480,5,240\n";
+  const auto edited = run_bodyfit(fmt::format("ensemble {} -o {} --members 4", case_file.string(), (dir / "run").string()));
+  CHECK(edited.exit_code == 1);
+  CHECK_MESSAGE(edited.output.find("input_files.model.wind.file") != std::string::npos, edited.output);
+}
+
 TEST_CASE("ensemble: killed (SIGKILL) at any point, the same command completes it with the same bytes") {
   TempDir dir("ensemble_killed");
   const fs::path case_file = write_case(dir);

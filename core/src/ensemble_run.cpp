@@ -7,6 +7,7 @@
 #include <bodyfit/run_directory.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <tbb/task_arena.h>
 #include <toml++/toml.h>
@@ -23,11 +24,12 @@ namespace {
 namespace fs = std::filesystem;
 
 /// The case an ensemble directory holds, as canonical text: the case file after the overrides,
-/// without the member count (a finished ensemble may be extended with more members).
-std::string ensemble_identity(const fs::path& case_file, const std::vector<std::string>& overrides) {
+/// without the member count (a finished ensemble may be extended with more members), with the
+/// digests of the files it names (with_input_digests) unless `digests` is false.
+std::string ensemble_identity(const fs::path& case_file, const std::vector<std::string>& overrides, bool digests) {
   toml::table table = read_case_table(case_file, overrides);
   if (toml::table* ensemble = table["ensemble"].as_table()) ensemble->erase("members");
-  return canonical_case(table);
+  return canonical_case(digests ? with_input_digests(table, case_file.parent_path()) : table);
 }
 
 /// Rank 0's preparation of the directory: created, the case recorded (or checked against the
@@ -37,16 +39,23 @@ void prepare_directory(const EnsembleOptions& options, const std::vector<std::st
   std::error_code ec;
   fs::create_directories(members, ec);
   if (ec) throw IoError(fmt::format("{}: cannot create the output directory ({})", members.string(), ec.message()));
-  const std::string identity = ensemble_identity(options.case_file, overrides);
+  const std::string identity = ensemble_identity(options.case_file, overrides, true);
   const fs::path recorded = options.outdir / "ensemble_case.toml";
   if (fs::exists(recorded)) {
     std::ifstream in(recorded);
     std::ostringstream text;
     text << in.rdbuf();
-    if (text.str() != identity)
-      throw InputError(fmt::format("{} holds an ensemble of another case (or other --set or --seed values; see {}): "
-                                   "use another output directory",
-                                   options.outdir.string(), recorded.string()));
+    // A directory recorded before the digests existed holds the case without them.
+    const bool same = text.str() == identity ||
+                      (text.str().find("input_files") == std::string::npos &&
+                       text.str() == ensemble_identity(options.case_file, overrides, false));
+    if (!same) {
+      std::vector<std::string> keys;
+      for (const CaseChange& change : case_changes(text.str(), identity)) keys.push_back(change.key);
+      throw InputError(fmt::format("{} holds an ensemble of another case (or other --set or --seed values, or an "
+                                   "edited data file: {}; see {}): use another output directory",
+                                   options.outdir.string(), fmt::join(keys, ", "), recorded.string()));
+    }
   } else {
     write_atomically(recorded, [&](std::ostream& out) { out << identity; });
   }
