@@ -432,3 +432,57 @@ TEST_CASE("Advector::advect_band: the whole-mesh advection at the traced vertice
   advector.advect_band(phi, partial, 10 * T, traced, thin, out, {}, &report);
   CHECK(report.outside_band > 0);
 }
+
+TEST_CASE("Advector::advect_band_composed: sub-steps of a translation give the one-step result, not K interpolations") {
+  // A uniform V on a plane: the composed foot map is affine, so its interpolation is exact and K
+  // composed calls of T/K interpolate phi once, at the same foot as one call of T. Interpolating phi
+  // at every call (advect_band) adds K interpolation errors of a curved phi instead.
+  const int n = 40;
+  const SurfaceMesh mesh = make_square(n);
+  const double h = 1.0 / n;
+  const ScalarField phi = sample(mesh, [](const Vec3& p) {
+    return (p[0] - 0.4) * (p[0] - 0.4) + (p[1] - 0.6) * (p[1] - 0.6) - 0.04;
+  });
+  const Vec3 V(0.3, -0.2, 0);
+  const VectorField velocity(mesh.n_vertices(), V);
+  const double T = 0.5;
+  const int K = 4;
+  std::vector<int> all(mesh.n_vertices());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+  Advector advector(mesh);
+  const ScalarField once = advector.advect(phi, velocity, T);
+  ScalarField composed = phi, interpolated = phi;
+  advector.start_composition(phi);
+  for (int k = 0; k < K; ++k) {
+    ScalarField next = composed;
+    AdvectionReport report;
+    advector.advect_band_composed(composed, velocity, T / K, all, all, next, {}, &report);
+    CHECK(report.lost == 0);
+    composed = std::move(next);
+    next = interpolated;
+    advector.advect_band(interpolated, velocity, T / K, all, all, next);
+    interpolated = std::move(next);
+  }
+  // Feet stopped on the inflow boundary are not a translation, and each call interpolates the feet
+  // of vertices up to an edge further out: compared, the vertices whose characteristic stays K + 1
+  // edges inside the square.
+  double worst_composed = 0, worst_interpolated = 0;
+  std::size_t compared = 0;
+  for (auto v : mesh.vertices()) {
+    const Vec3 foot = mesh.point(v) - T * V;
+    const Vec3 start = mesh.point(v);
+    const double margin = (K + 1) * h;
+    if (std::min({foot[0], foot[1], start[0], start[1]}) < margin ||
+        std::max({foot[0], foot[1], start[0], start[1]}) > 1 - margin)
+      continue;
+    ++compared;
+    worst_composed = std::max(worst_composed, std::abs(composed[v.idx()] - once[v.idx()]));
+    worst_interpolated = std::max(worst_interpolated, std::abs(interpolated[v.idx()] - once[v.idx()]));
+  }
+  MESSAGE("largest difference to one step of T: " << worst_composed << " composed, " << worst_interpolated
+                                                   << " interpolated at every call (" << compared << " vertices)");
+  CHECK(compared > 100);
+  // Rounding: a walk snaps to an edge within 1e-11 of its length (walk() in advection.cpp).
+  CHECK(worst_composed <= 1e-10);
+  CHECK(worst_interpolated > 1e-5);  // 2.4e-4
+}

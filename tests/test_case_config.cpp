@@ -195,6 +195,9 @@ TEST_CASE("[time] max_rejections: an integer >= 0, default 5") {
   CHECK_MESSAGE(contains(e, "[time] max_rejections: expected an integer, got a float"), e);
   e = error_of(kValidCase, {"time.max_rejection=3"});
   CHECK_MESSAGE(contains(e, "unknown key 'max_rejection' in [time]; did you mean 'max_rejections'?"), e);
+  // The sub-steps' composition: off unless asked (EvolutionOptions::compose_substeps).
+  CHECK_FALSE(parse(kValidCase).time.compose_substeps);
+  CHECK(parse(kValidCase, {"time.compose_substeps=true"}).time.compose_substeps);
 }
 
 TEST_CASE("--set overrides any key with a dotted path, typed as TOML") {

@@ -447,6 +447,47 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
   return r;
 }
 
+/// A vertex as a location: a corner of its face.
+Location vertex_location(const Surface& s, int v) {
+  Location at;
+  at.face = s.vertex_face[v];
+  at.b[0] = at.b[1] = at.b[2] = 0.0;
+  at.b[s.vertex_slot[v]] = 1.0;
+  return at;
+}
+
+Vec3 position(const Surface& s, const Location& at) {
+  const std::array<int, 3>& c = s.corners[at.face];
+  return at.b[0] * s.points[c[0]] + at.b[1] * s.points[c[1]] + at.b[2] * s.points[c[2]];
+}
+
+/// Walk `at` by a 3-D displacement, taken in the plane of its face (then unfolded as any walk).
+WalkEnd walk_by(const Surface& s, Location& at, const Vec3& displacement) {
+  const std::array<int, 3>& c = s.corners[at.face];
+  const auto grad = p1_basis_gradients(s.points[c[0]], s.points[c[1]], s.points[c[2]]);
+  Delta d;
+  d.d[0] = OpenMesh::dot(grad[0], displacement);
+  d.d[1] = OpenMesh::dot(grad[1], displacement);
+  d.d[2] = -(d.d[0] + d.d[1]);
+  return walk(s, at, d, nullptr);
+}
+
+/// φ at a location: P1, or with `gradients` the mean of P1 and of the corners' Taylor planes,
+/// clamped to the face's range (AdvectionOptions::gradient_correction).
+double value_at(const Surface& s, const ScalarField& phi, const VectorField* gradients, const Location& at) {
+  const std::array<int, 3>& c = s.corners[at.face];
+  const double value = at.b[0] * phi[c[0]] + at.b[1] * phi[c[1]] + at.b[2] * phi[c[2]];
+  if (!gradients) return value;
+  const Vec3 x = position(s, at);
+  double taylor = 0, lo = phi[c[0]], hi = phi[c[0]];
+  for (int j = 0; j < 3; ++j) {
+    taylor += at.b[j] * (phi[c[j]] + OpenMesh::dot((*gradients)[c[j]], x - s.points[c[j]]));
+    lo = std::min(lo, phi[c[j]]);
+    hi = std::max(hi, phi[c[j]]);
+  }
+  return std::clamp(0.5 * (value + taylor), lo, hi);
+}
+
 void check_inputs(const SurfaceMesh& mesh, std::size_t phi_size, std::size_t other_size, double T,
                   const AdvectionOptions& options, const char* what) {
   if (phi_size != mesh.n_vertices())
@@ -531,7 +572,6 @@ void check_substep_budget(const Surface& s, const VectorField& velocity, std::sp
 void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField* gradients, std::span<const int> order,
                     double T, const AdvectionOptions& options, std::uint32_t epoch, double vmax, ScalarField& out,
                     AdvectionReport* report) {
-  const std::vector<Vec3>& points = s.points;
   const std::size_t max_substeps = substep_bound(s, vmax, T, options);
   std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -539,29 +579,118 @@ void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField*
     std::vector<Crossed> path;  // scratch for RK4 stages
     for (std::size_t k = range.begin(); k != range.end(); ++k) {
       const int v = order[k];
-      const int fi = s.vertex_face[v];
-      if (fi < 0) {  // isolated vertex: nothing carries it
+      if (s.vertex_face[v] < 0) {  // isolated vertex: nothing carries it
         out[v] = phi[v];
         continue;
       }
-      Location start;
-      start.face = fi;
-      start.b[0] = start.b[1] = start.b[2] = 0.0;
-      start.b[s.vertex_slot[v]] = 1.0;
+      const Location start = vertex_location(s, v);
       const TraceResult r = trace(s, start, T, options, epoch, max_substeps, path);
-      const std::array<int, 3>& c = s.corners[r.foot.face];
-      double value = r.foot.b[0] * phi[c[0]] + r.foot.b[1] * phi[c[1]] + r.foot.b[2] * phi[c[2]];
-      if (gradients && !r.outside) {
-        const Vec3 x = r.foot.b[0] * points[c[0]] + r.foot.b[1] * points[c[1]] + r.foot.b[2] * points[c[2]];
-        double taylor = 0, lo = phi[c[0]], hi = phi[c[0]];
-        for (int j = 0; j < 3; ++j) {
-          taylor += r.foot.b[j] * (phi[c[j]] + OpenMesh::dot((*gradients)[c[j]], x - points[c[j]]));
-          lo = std::min(lo, phi[c[j]]);
-          hi = std::max(hi, phi[c[j]]);
-        }
-        value = std::clamp(0.5 * (value + taylor), lo, hi);
+      out[v] = value_at(s, phi, r.outside ? nullptr : gradients, r.foot);
+      ++local_traced;
+      local_sub += r.substeps;
+      local_boundary += r.boundary;
+      local_lost += r.stalled;
+      local_outside += r.outside;
+    }
+    substeps += local_sub;
+    boundary += local_boundary;
+    lost += local_lost;
+    traced += local_traced;
+    outside += local_outside;
+  });
+  if (report) {
+    report->traced = traced;
+    report->substeps = substeps;
+    report->hit_boundary = boundary;
+    report->lost = lost;
+    report->outside_band = outside;
+  }
+}
+
+/// The composed characteristics of one step's CFL sub-steps (Advector::start_composition): each
+/// vertex's foot, on the step's initial level set φ0, of its characteristic over the sub-steps so
+/// far. φ0 is interpolated once per value, at the composed foot; what is interpolated every
+/// sub-step is the foot map, which is smooth where the characteristics do not meet.
+struct Composition {
+  bool started = false;
+  ScalarField base;             ///< φ0
+  VectorField base_gradients;   ///< its vertex gradients (correction, and placing new feet)
+  std::vector<Location> feet;   ///< valid where `carried` is the previous call
+  std::vector<Location> fresh;  ///< this call's feet of the traced vertices
+  std::vector<unsigned char> composed;  ///< this call: the traced vertex's foot was composed
+  std::vector<std::uint32_t> carried;   ///< the call that set the vertex's foot
+  std::uint32_t calls = 0;
+};
+
+/// Never a previous call: the foot must be placed again.
+constexpr std::uint32_t kNoFoot = std::numeric_limits<std::uint32_t>::max();
+
+/// Feet spread this many times more than the corners they come from: characteristics that meet
+/// (two fronts merging), where the foot map is not smooth and its interpolation lands between
+/// them; there φ is interpolated as without composition.
+constexpr double kMeetingSpread = 4.0;
+
+/// A foot for a vertex that no previous call carried (it just entered the band or the traced
+/// set): where φ0 has its current value, walking from it along −∇φ0 (a distance, so by the
+/// difference); far from the front, where the characteristics are the normals of φ0.
+Location place_foot(const Surface& s, const Composition& c, const ScalarField& phi, int v) {
+  Location at = vertex_location(s, v);
+  const Vec3& g = c.base_gradients[v];
+  const double length = g.norm();
+  const double travel = c.base[v] - phi[v];
+  if (length > 1e-12 && travel != 0) walk_by(s, at, (-travel / length) * g);
+  return at;
+}
+
+/// Trace the vertices of `order` over T and write φ0 at their composed feet into out (composition
+/// fresh/composed filled); where the feet cannot be composed, φ at the foot as trace_vertices does.
+void trace_composed(const Surface& s, Composition& c, const ScalarField& phi, const VectorField* gradients,
+                    std::span<const int> order, double T, const AdvectionOptions& options, std::uint32_t epoch,
+                    double vmax, ScalarField& out, AdvectionReport* report) {
+  const std::size_t max_substeps = substep_bound(s, vmax, T, options);
+  const std::uint32_t previous = c.calls - 1;
+  const VectorField* base_gradients = gradients ? &c.base_gradients : nullptr;
+  std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0, local_outside = 0;
+    std::vector<Crossed> path;
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      const int v = order[k];
+      c.composed[v] = 0;
+      if (s.vertex_face[v] < 0) {
+        out[v] = phi[v];
+        continue;
       }
-      out[v] = value;
+      const TraceResult r = trace(s, vertex_location(s, v), T, options, epoch, max_substeps, path);
+      const std::array<int, 3>& corner = s.corners[r.foot.face];
+      bool composable = !r.outside && !r.stalled && c.carried[corner[0]] == previous &&
+                        c.carried[corner[1]] == previous && c.carried[corner[2]] == previous;
+      if (composable) {
+        // The foot map interpolated at this sub-step's foot: the 3-D mean of the corners' feet,
+        // reached by walking from the foot of the nearest corner.
+        const Vec3 y = position(s, r.foot);
+        Vec3 target(0, 0, 0);
+        Vec3 foot_of[3];
+        int nearest = 0;
+        for (int j = 0; j < 3; ++j) {
+          foot_of[j] = position(s, c.feet[corner[j]]);
+          target += r.foot.b[j] * foot_of[j];
+          if (r.foot.b[j] > r.foot.b[nearest]) nearest = j;
+        }
+        double spread = 0, reach = 0;
+        for (int j = 0; j < 3; ++j) {
+          spread = std::max(spread, (foot_of[j] - target).norm());
+          reach = std::max(reach, (s.points[corner[j]] - y).norm());
+        }
+        Location foot = c.feet[corner[nearest]];
+        composable = spread <= kMeetingSpread * reach && walk_by(s, foot, target - foot_of[nearest]) == WalkEnd::arrived;
+        if (composable) {
+          c.fresh[v] = foot;
+          c.composed[v] = 1;
+          out[v] = value_at(s, c.base, base_gradients, foot);
+        }
+      }
+      if (!composable) out[v] = value_at(s, phi, r.outside ? nullptr : gradients, r.foot);
       ++local_traced;
       local_sub += r.substeps;
       local_boundary += r.boundary;
@@ -593,6 +722,13 @@ struct Advector::Impl {
   VectorField gradients;                  ///< of φ, where the current call needs them
   std::vector<std::uint32_t> vertex_seen;  ///< band calls: = epoch for the vertices where V is known
   std::vector<int> faces, order;          ///< band calls: faces with V known at 3 corners; traced in Z-order
+  Composition composition;                ///< composed band calls
+
+  /// What a band call needs before tracing: V on the faces with three known corners, φ's gradients
+  /// at the known vertices; the traced vertices in Z-order. Returns the call's epoch and max |V|.
+  std::pair<std::uint32_t, double> prepare_band(const ScalarField& phi, const VectorField& velocity, double T,
+                                                std::span<const int> traced, std::span<const int> known,
+                                                const ScalarField& out, const AdvectionOptions& options);
 };
 
 Advector::Advector(const SurfaceMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {}
@@ -617,44 +753,99 @@ ScalarField Advector::advect(const ScalarField& phi, const VectorField& velocity
   return out;
 }
 
+std::pair<std::uint32_t, double> Advector::Impl::prepare_band(const ScalarField& phi, const VectorField& velocity,
+                                                             double T, std::span<const int> traced,
+                                                             std::span<const int> known, const ScalarField& out,
+                                                             const AdvectionOptions& options) {
+  check_inputs(mesh, phi.size(), velocity.size(), T, options, "the velocity");
+  if (out.size() != phi.size()) throw InputError("advect_band: the output has one value per vertex");
+  Surface& s = surface;
+  const std::size_t nv = s.points.size();
+  const double vmax = largest_speed(velocity, known);
+  check_substep_budget(s, velocity, traced, T, options);
+  const std::uint32_t call = ++epoch;
+  if (s.fan_start.empty()) build_fans(s);
+  vertex_seen.resize(nv, 0);
+  for (int v : known) vertex_seen[v] = call;
+  // The faces whose three corners have V: each once, found from its lowest known corner.
+  faces.clear();
+  for (int v : known)
+    for (int j = s.fan_start[v]; j < s.fan_start[v + 1]; ++j) {
+      const std::array<int, 3>& c = s.corners[s.fan[j]];
+      if (vertex_seen[c[0]] == call && vertex_seen[c[1]] == call && vertex_seen[c[2]] == call &&
+          v == std::min({c[0], c[1], c[2]}))
+        faces.push_back(s.fan[j]);
+    }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) fill_motion(s, faces[k], velocity, call);
+  });
+  if (options.gradient_correction) {
+    gradients.resize(nv);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, known.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
+      for (std::size_t k = range.begin(); k != range.end(); ++k)
+        gradients[known[k]] = vertex_gradient(mesh, VertexHandle(known[k]), phi);
+    });
+  }
+  // Z-order for the traces, as in a full call.
+  order.assign(traced.begin(), traced.end());
+  std::sort(order.begin(), order.end(), [&](int u, int w) { return s.vertex_rank[u] < s.vertex_rank[w]; });
+  return {call, vmax};
+}
+
 void Advector::advect_band(const ScalarField& phi, const VectorField& velocity, double T, std::span<const int> traced,
                            std::span<const int> known, ScalarField& out, const AdvectionOptions& options,
                            AdvectionReport* report) {
   Impl& a = *impl_;
-  check_inputs(a.mesh, phi.size(), velocity.size(), T, options, "the velocity");
-  if (out.size() != phi.size()) throw InputError("advect_band: the output has one value per vertex");
-  Surface& s = a.surface;
+  const auto [epoch, vmax] = a.prepare_band(phi, velocity, T, traced, known, out, options);
+  trace_vertices(a.surface, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, vmax,
+                 out, report);
+}
+
+void Advector::start_composition(const ScalarField& phi0) {
+  Impl& a = *impl_;
+  if (phi0.size() != a.mesh.n_vertices())
+    throw InputError(fmt::format("start_composition: {} values for {} vertices", phi0.size(), a.mesh.n_vertices()));
+  Composition& c = a.composition;
+  const Surface& s = a.surface;
   const std::size_t nv = s.points.size();
-  const double vmax = largest_speed(velocity, known);
-  check_substep_budget(s, velocity, traced, T, options);
-  const std::uint32_t epoch = ++a.epoch;
-  if (s.fan_start.empty()) build_fans(s);
-  a.vertex_seen.resize(nv, 0);
-  for (int v : known) a.vertex_seen[v] = epoch;
-  // The faces whose three corners have V: each once, found from its lowest known corner.
-  a.faces.clear();
-  for (int v : known)
-    for (int j = s.fan_start[v]; j < s.fan_start[v + 1]; ++j) {
-      const std::array<int, 3>& c = s.corners[s.fan[j]];
-      if (a.vertex_seen[c[0]] == epoch && a.vertex_seen[c[1]] == epoch && a.vertex_seen[c[2]] == epoch &&
-          v == std::min({c[0], c[1], c[2]}))
-        a.faces.push_back(s.fan[j]);
+  c.started = true;
+  c.base = phi0;
+  c.base_gradients = vertex_gradients(a.mesh, phi0);
+  c.feet.resize(nv);
+  c.fresh.resize(nv);
+  c.composed.assign(nv, 0);
+  // Every foot is its vertex before the first sub-step (the first call's previous one is 0).
+  c.calls = 0;
+  c.carried.assign(nv, 0);
+  for (std::size_t v = 0; v < nv; ++v)
+    if (s.vertex_face[v] >= 0) c.feet[v] = vertex_location(s, int(v));
+    else c.carried[v] = kNoFoot;
+}
+
+void Advector::advect_band_composed(const ScalarField& phi, const VectorField& velocity, double T,
+                                    std::span<const int> traced, std::span<const int> known, ScalarField& out,
+                                    const AdvectionOptions& options, AdvectionReport* report) {
+  Impl& a = *impl_;
+  Composition& c = a.composition;
+  if (!c.started) throw InputError("advect_band_composed: start_composition was not called");
+  const auto [epoch, vmax] = a.prepare_band(phi, velocity, T, traced, known, out, options);
+  const Surface& s = a.surface;
+  const std::uint32_t previous = c.calls++;
+  // The known vertices no previous call carried get a foot where φ0 has their value.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, known.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      const int v = known[k];
+      if (c.carried[v] == previous || s.vertex_face[v] < 0) continue;
+      c.feet[v] = place_foot(s, c, phi, v);
+      c.carried[v] = previous;
     }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.faces.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t k = range.begin(); k != range.end(); ++k) fill_motion(s, a.faces[k], velocity, epoch);
   });
-  if (options.gradient_correction) {
-    a.gradients.resize(nv);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, known.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
-      for (std::size_t k = range.begin(); k != range.end(); ++k)
-        a.gradients[known[k]] = vertex_gradient(a.mesh, VertexHandle(known[k]), phi);
-    });
+  trace_composed(s, c, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, vmax,
+                 out, report);
+  for (int v : a.order) {
+    c.carried[v] = c.composed[v] ? c.calls : kNoFoot;
+    if (c.composed[v]) c.feet[v] = c.fresh[v];
   }
-  // Z-order for the traces, as in a full call.
-  a.order.assign(traced.begin(), traced.end());
-  std::sort(a.order.begin(), a.order.end(), [&](int u, int w) { return s.vertex_rank[u] < s.vertex_rank[w]; });
-  trace_vertices(s, phi, options.gradient_correction ? &a.gradients : nullptr, a.order, T, options, epoch, vmax, out,
-                 report);
 }
 
 ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const VectorField& velocity, double T,

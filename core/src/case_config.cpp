@@ -203,6 +203,7 @@ void parse_time(const toml::table& table, TimeSpec& out) {
   out.max_cfl = p.number("max_cfl", 0, kPositive);
   out.narrow_band = p.boolean("narrow_band", out.narrow_band);
   out.keep_crossings = p.boolean("keep_crossings", out.keep_crossings);
+  out.compose_substeps = p.boolean("compose_substeps", out.compose_substeps);
   out.max_substeps = long(p.integer("max_substeps", out.max_substeps, 0));
   out.final_time = p.number("final_time", out.final_time, kPositive);
   out.iterations = long(p.integer("iterations", -1, 0));

@@ -223,6 +223,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.max_cfl = config.time.max_cfl;
   options.narrow_band = config.time.narrow_band;
   options.keep_crossings = config.time.keep_crossings;
+  options.compose_substeps = config.time.compose_substeps;
   options.max_substeps = config.time.max_substeps;
   options.max_rejections = config.time.max_rejections;
   options.cfl_length = setup.h;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <optional>
 #include <span>
 #include <stdexcept>
@@ -221,6 +222,16 @@ class Evolution {
     ScalarField phi = distance_, next;
     std::vector<int> band = within(phi, width), traced;
     if (in_band) next = phi;
+    const bool compose = options_.compose_substeps;
+    const AdvectionOptions& advection = options_.advection;
+    std::vector<int> everything;  // where composed whole-surface sub-steps know V
+    if (compose) {
+      advector.start_composition(phi);
+      if (!in_band) {
+        everything.resize(mesh_.n_vertices());
+        std::iota(everything.begin(), everything.end(), 0);
+      }
+    }
     step.ms.distance += clock.lap_ms();
     VectorField velocity;
     while (step.done < dt) {
@@ -256,11 +267,22 @@ class Evolution {
       const double sub = substep_length(velocity, traced, remaining, step.substeps);
       if (in_band) {
         AdvectionReport report;
-        advector.advect_band(phi, velocity, sub, traced, band, next, options_.advection, &report);
+        if (compose)
+          advector.advect_band_composed(phi, velocity, sub, traced, band, next, advection, &report);
+        else
+          advector.advect_band(phi, velocity, sub, traced, band, next, advection, &report);
         check_report(report);
         model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt, traced});
         for (int v : traced) phi[v] = next[v];
         advance_substep(step, sub, remaining, dt);
+      } else if (compose) {
+        AdvectionReport report;
+        next = phi;  // as in the band: only the vertices the front can reach are traced
+        advector.advect_band_composed(phi, velocity, sub, traced, everything, next, advection, &report);
+        check_report(report);
+        model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt});
+        advance_substep(step, sub, remaining, dt);
+        std::swap(phi, next);
       } else {
         phi = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
       }

@@ -65,6 +65,21 @@ class Advector {
                    std::span<const int> known, ScalarField& out, const AdvectionOptions& options = {},
                    AdvectionReport* report = nullptr);
 
+  /// Composed sub-steps (EvolutionOptions::compose_substeps): the band calls that follow continue
+  /// each vertex's characteristic back to the start of the step, where φ is `phi0`, and give φ0 at
+  /// the composed foot; the foot map is interpolated every call instead of φ. φ interpolated at
+  /// every sub-step's foot makes an O(h²) error each time, which adds up with the sub-steps; the
+  /// foot map is smooth, so composing feet does not (docs/fire.md, "Sub-steps that converge").
+  void start_composition(const ScalarField& phi0);
+  /// As advect_band, with the characteristics composed since start_composition. `phi` (the current
+  /// φ, a distance near its zero set) places the feet of the vertices that no previous call traced
+  /// (walking from them along −∇φ0 to where φ0 = φ) and gives the value where feet cannot be
+  /// composed: the trace left the band, a corner of the foot's face has no foot, or the corners'
+  /// feet spread far apart (characteristics that meet, as merging fronts do).
+  void advect_band_composed(const ScalarField& phi, const VectorField& velocity, double T, std::span<const int> traced,
+                            std::span<const int> known, ScalarField& out, const AdvectionOptions& options = {},
+                            AdvectionReport* report = nullptr);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

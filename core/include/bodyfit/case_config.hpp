@@ -9,7 +9,7 @@
 //                | "ignitions" (file = a vector layer of points, lines, polygons; radius; time_attribute)
 //   [model]      name = "conormal", every other key is the model's own parameter
 //   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, narrow_band, keep_crossings, max_substeps,
-//                max_rejections; start = "2026-07-14T13:00:00Z" (the clock time of t = 0)
+//                compose_substeps, max_rejections; start = "2026-07-14T13:00:00Z" (the clock time of t = 0)
 //   [distance] [advection] [discretize] [remesh]   options of each stage
 //   [output]     vtu_every, png_every, field, view, size = [w, h], checkpoint_every, checkpoint_seconds
 //
@@ -80,6 +80,7 @@ struct TimeSpec {
   double max_cfl = 0;  ///< sub-steps keep max|V|·Δt_sub ≤ max_cfl·h (0: off; EvolutionOptions::max_cfl)
   bool narrow_band = true;  ///< sub-steps work near the front only (EvolutionOptions::narrow_band)
   bool keep_crossings = true;  ///< EvolutionOptions::keep_crossings
+  bool compose_substeps = false;  ///< EvolutionOptions::compose_substeps
   long max_substeps = 10000;  ///< sub-steps one step may take (0: no limit; EvolutionOptions::max_substeps)
   double final_time = std::numeric_limits<double>::infinity();
   long iterations = -1;  ///< −1: no limit (final_time decides)

@@ -105,6 +105,12 @@ struct EvolutionOptions {
   /// those vertices get the distance to the P1 zero set each sub-step, which shifts the front by
   /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/fire.md).
   bool keep_crossings = true;
+  /// With max_cfl: compose the sub-steps' characteristics back to the start of the step and
+  /// interpolate φ^n once at the composed feet (Advector::start_composition), instead of φ at the
+  /// feet of every sub-step. On a steep plane the head then lands 5 % from the exact front at 45
+  /// sub-steps per step instead of 16 %; on the four-fire case it changes nothing measurable, so it
+  /// is off by default (docs/fire.md, "Sub-steps that converge").
+  bool compose_substeps = false;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   /// CFL sub-steps one step may take (0: no limit): a Δt far beyond what the speeds allow is an
   /// InputError at the step that needs more, naming the count, not a run that never ends.
