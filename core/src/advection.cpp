@@ -365,6 +365,38 @@ struct TraceResult {
   bool outside = false;  ///< reached a face where V is not known (a band call)
 };
 
+/// What one thread's share of a tracing call did (AdvectionReport's counts).
+struct TraceCounts {
+  std::size_t traced = 0, substeps = 0, boundary = 0, lost = 0, outside = 0;
+  void add(const TraceResult& r) {
+    ++traced;
+    substeps += r.substeps;
+    boundary += r.boundary;
+    lost += r.stalled;
+    outside += r.outside;
+  }
+};
+
+/// The sum over the threads of a tracing call.
+struct TraceTotals {
+  std::atomic<std::size_t> traced{0}, substeps{0}, boundary{0}, lost{0}, outside{0};
+  void add(const TraceCounts& c) {
+    traced += c.traced;
+    substeps += c.substeps;
+    boundary += c.boundary;
+    lost += c.lost;
+    outside += c.outside;
+  }
+  void report_to(AdvectionReport* report) const {
+    if (!report) return;
+    report->traced = traced;
+    report->substeps = substeps;
+    report->hit_boundary = boundary;
+    report->lost = lost;
+    report->outside_band = outside;
+  }
+};
+
 /// Trace the characteristic through `start` backwards over a time T, reading V on the faces whose
 /// motion was filled by the call `epoch`.
 TraceResult trace(const Surface& s, Location start, double T, const AdvectionOptions& opt, std::uint32_t epoch,
@@ -573,9 +605,9 @@ void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField*
                     double T, const AdvectionOptions& options, std::uint32_t epoch, double vmax, ScalarField& out,
                     AdvectionReport* report) {
   const std::size_t max_substeps = substep_bound(s, vmax, T, options);
-  std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
+  TraceTotals totals;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0, local_outside = 0;
+    TraceCounts counts;
     std::vector<Crossed> path;  // scratch for RK4 stages
     for (std::size_t k = range.begin(); k != range.end(); ++k) {
       const int v = order[k];
@@ -586,25 +618,11 @@ void trace_vertices(const Surface& s, const ScalarField& phi, const VectorField*
       const Location start = vertex_location(s, v);
       const TraceResult r = trace(s, start, T, options, epoch, max_substeps, path);
       out[v] = value_at(s, phi, r.outside ? nullptr : gradients, r.foot);
-      ++local_traced;
-      local_sub += r.substeps;
-      local_boundary += r.boundary;
-      local_lost += r.stalled;
-      local_outside += r.outside;
+      counts.add(r);
     }
-    substeps += local_sub;
-    boundary += local_boundary;
-    lost += local_lost;
-    traced += local_traced;
-    outside += local_outside;
+    totals.add(counts);
   });
-  if (report) {
-    report->traced = traced;
-    report->substeps = substeps;
-    report->hit_boundary = boundary;
-    report->lost = lost;
-    report->outside_band = outside;
-  }
+  totals.report_to(report);
 }
 
 /// The composed characteristics of one step's CFL sub-steps (Advector::start_composition): each
@@ -650,9 +668,9 @@ void trace_composed(const Surface& s, Composition& c, const ScalarField& phi, co
   const std::size_t max_substeps = substep_bound(s, vmax, T, options);
   const std::uint32_t previous = c.calls - 1;
   const VectorField* base_gradients = gradients ? &c.base_gradients : nullptr;
-  std::atomic<std::size_t> substeps{0}, boundary{0}, lost{0}, traced{0}, outside{0};
+  TraceTotals totals;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, order.size(), 256), [&](const tbb::blocked_range<std::size_t>& range) {
-    std::size_t local_sub = 0, local_boundary = 0, local_lost = 0, local_traced = 0, local_outside = 0;
+    TraceCounts counts;
     std::vector<Crossed> path;
     for (std::size_t k = range.begin(); k != range.end(); ++k) {
       const int v = order[k];
@@ -691,25 +709,11 @@ void trace_composed(const Surface& s, Composition& c, const ScalarField& phi, co
         }
       }
       if (!composable) out[v] = value_at(s, phi, r.outside ? nullptr : gradients, r.foot);
-      ++local_traced;
-      local_sub += r.substeps;
-      local_boundary += r.boundary;
-      local_lost += r.stalled;
-      local_outside += r.outside;
+      counts.add(r);
     }
-    substeps += local_sub;
-    boundary += local_boundary;
-    lost += local_lost;
-    traced += local_traced;
-    outside += local_outside;
+    totals.add(counts);
   });
-  if (report) {
-    report->traced = traced;
-    report->substeps = substeps;
-    report->hit_boundary = boundary;
-    report->lost = lost;
-    report->outside_band = outside;
-  }
+  totals.report_to(report);
 }
 
 }  // namespace
