@@ -2,16 +2,22 @@
 // and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/performance.md).
 //
 //   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--iterations N]
-//                       [--reference-factor 4] [-o out.csv]
+//                       [--reference-factor 4] [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]
 //
-// Runs the case three times from the same T^0: "band" (the case as shipped: its max_cfl, sub-steps
-// in a narrow band), "whole" (the same sub-steps on the whole surface) and "reference" (max_cfl
-// divided by the factor, whole surface). After every step it records the time per iteration, the
-// sub-steps, the components of G and its area, and the gap between its front and the reference's
-// at the same time (the distances from every end and midpoint of either front's edges to the other:
-// mean, 95th percentile, max), in units of the case's h. Prints a summary (the worst step of each,
-// the step where G becomes one component, the most components) and writes one CSV row per run and step,
-// with the gap to the band run too (band_gap_max_h, band_gap_mean_h: the rounding-level spread).
+// Runs the case from the same T^0 as "band" (the case as shipped: its max_cfl, sub-steps in a narrow
+// band), "whole" (the same sub-steps on the whole surface), "reference" (max_cfl divided by the
+// factor, whole surface) and "floor" (the band run with hmax × (1 + --floor-perturbation): the same
+// problem and sub-steps on other meshes from the first remesh on). After every step it records the
+// time per iteration, the sub-steps, the components of G and its area, and the gap between its front
+// and the reference's at the same time (the distances from every end and midpoint of either front's
+// edges to the other: mean, median, 95th percentile, max) and the signed offset (the difference of
+// the burnt areas over the fronts' mean length: > 0 ahead of the reference), all in units of the
+// case's h. The floor run's gap to the band run is how far two meshes alone take the same
+// computation apart: the yardstick for the gap to the reference. Prints a summary (the worst step of
+// each, the last step's median and offset, the step where G becomes one component, the most
+// components) and writes one CSV row per run and step, with the gap to the band run too
+// (band_gap_max_h, band_gap_mean_h). --fronts DIR writes every run's front at every step as
+// DIR/<run>_<step>.txt, one segment "x0 y0 z0 x1 y1 z1" per line.
 #include "bench_args.hpp"
 
 #include <bodyfit/case_config.hpp>
@@ -37,8 +43,14 @@ namespace {
 
 /// Distances between two fronts: from every end and midpoint of a segment of either to the other.
 struct FrontGap {
-  double mean = 0, p95 = 0, max = 0;
+  double mean = 0, median = 0, p95 = 0, max = 0;
 };
+
+double front_length(const Segments& front) {
+  double length = 0;
+  for (const auto& [a, b] : front) length += (b - a).norm();
+  return length;
+}
 
 double to_segments(const Vec3& p, const Segments& to) {
   double nearest = std::numeric_limits<double>::infinity();
@@ -60,6 +72,7 @@ FrontGap front_gap(const Segments& a, const Segments& b) {
   std::sort(d.begin(), d.end());
   FrontGap g;
   for (double x : d) g.mean += x / double(d.size());
+  g.median = d[(d.size() - 1) / 2];
   g.p95 = d[std::size_t(0.95 * double(d.size() - 1))];
   g.max = d.back();
   return g;
@@ -68,7 +81,8 @@ FrontGap front_gap(const Segments& a, const Segments& b) {
 struct StepRecord {
   int iteration = 0;
   double time = 0, area = 0, ms = 0, band_error = 0, band_mean = 0;  // gap to the band run: max, mean (in h)
-  FrontGap gap;  ///< to the reference's front at the same step
+  FrontGap gap;       ///< to the reference's front at the same step
+  double offset = 0;  ///< signed: (area − the reference's area) / the fronts' mean length
   int components = 0;
   std::size_t faces = 0;
   int substeps = 0;
@@ -82,12 +96,14 @@ struct Run {
   double h = 0;  ///< the case's h (hmax, or the mean edge of T^0)
 };
 
-Run run(const std::string& name, const CaseConfig& config, double max_cfl, bool narrow_band, int iterations) {
+Run run(const std::string& name, const CaseConfig& config, double max_cfl, bool narrow_band, int iterations,
+        double hmax_factor = 1) {
   LoadedModel model = load_model(config.model);
   configure_model(model, config.model_parameters);
   CaseSetup setup = setup_case(config);
   setup.options.max_cfl = max_cfl;
   setup.options.narrow_band = narrow_band;
+  setup.options.remesh.hmax *= hmax_factor;  // T^0 is remeshed at the case's hmax: the floor differs from T^1 on
   if (iterations >= 0) setup.options.max_iterations = iterations;
   Run r{name, {}, 0, setup.h};
   EvolutionHooks hooks = EvolutionHooks::quiet();
@@ -123,22 +139,32 @@ int main(int argc, char** argv) {
   double h = 0;
   int iterations = -1;
   double factor = 4;
+  double perturbation = 1e-2;
+  std::filesystem::path fronts_dir;
   std::filesystem::path csv_path = "bench_fire_accuracy.csv";
   bench::Arguments args("bench_fire_accuracy",
                         "usage: bench_fire_accuracy [--case file.toml] [--h H] [--iterations N] [--reference-factor 4] "
-                        "[-o out.csv]\n"
+                        "[--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]\n"
                         "  --case              fire case with max_cfl > 0 (default meshes/cases/fire_four_disks.toml)\n"
                         "  --h                 surface.h and remesh.hmax in metres (default: the case's)\n"
                         "  --iterations        steps to run (default: the case's final time)\n"
                         "  --reference-factor  the reference divides max_cfl by this (default 4)\n"
+                        "  --floor-perturbation  the floor run (the band run on other meshes) multiplies hmax by\n"
+                        "                      1 + this after T^0 (default 0.01; 0: no floor run)\n"
+                        "  --fronts            directory: every run's front at every step, <run>_<step>.txt\n"
                         "  -o                  CSV, one row per run and step (default bench_fire_accuracy.csv)\n");
   args.option("--case", case_file);
   args.option("--h", h);
   args.option("--iterations", iterations);
   args.option("--reference-factor", factor);
+  args.option("--floor-perturbation", perturbation);
+  args.option("--fronts", fronts_dir);
   args.option("-o", csv_path);
   args.parse(argc, argv);
   if (!(factor >= 1)) args.fail("--reference-factor must be at least 1");
+  if (!(perturbation >= 0 && perturbation < 0.5)) args.fail("--floor-perturbation must be in [0, 0.5)");
+  if (!fronts_dir.empty() && !std::filesystem::is_directory(fronts_dir))
+    args.fail("--fronts: no directory " + fronts_dir.string());
   spdlog::set_level(spdlog::level::warn);
 
   std::vector<std::string> overrides;
@@ -150,31 +176,40 @@ int main(int argc, char** argv) {
   runs.push_back(run("reference", config, max_cfl / factor, false, iterations));
   runs.push_back(run("band", config, max_cfl, true, iterations));
   runs.push_back(run("whole", config, max_cfl, false, iterations));
+  if (perturbation > 0) runs.push_back(run("floor", config, max_cfl, true, iterations, 1 + perturbation));
   const Run& reference = runs[0];
   const double length = reference.h;
   std::map<int, const StepRecord*> by_iteration;
   for (const auto& s : reference.steps) by_iteration[s.iteration] = &s;
 
   std::ofstream csv(csv_path);
-  csv << "run,iteration,time,faces,substeps,components,area,ms_total,gap_mean_h,gap_p95_h,gap_max_h,band_gap_max_h,band_gap_mean_h\n";
+  csv << "run,iteration,time,faces,substeps,components,area,ms_total,gap_mean_h,gap_median_h,gap_p95_h,gap_max_h,"
+         "offset_h,band_gap_max_h,band_gap_mean_h\n";
   fmt::print("{}: h = {} m, max_cfl {} (reference {}), {} steps\n", case_file.string(), length, max_cfl,
              max_cfl / factor, reference.steps.size());
-  fmt::print("{:>10} {:>8} {:>8} {:>9} {:>6} {:>5} | gap to reference / h, worst step: {:>6} {:>6} {:>6} | {:>7}\n",
-             "run", "wall s", "ms/step", "sub-steps", "merge", "comp", "mean", "p95", "max", "vs band");
+  fmt::print("{:>10} {:>8} {:>8} {:>9} {:>6} {:>5} | to reference / h, worst step: {:>6} {:>6} {:>6}, last: {:>6} "
+             "{:>7} | to band, worst: {:>6} {:>6}\n",
+             "run", "wall s", "ms/step", "sub-steps", "merge", "comp", "mean", "p95", "max", "median", "offset", "mean",
+             "max");
   const Run* band = &runs[1];
   for (auto& r : runs) {
-    double worst = 0, worst_mean = 0, worst_p95 = 0, ms = 0, worst_band = 0;
+    double worst = 0, worst_mean = 0, worst_p95 = 0, ms = 0, worst_band = 0, worst_band_mean = 0;
     int substeps = 0;
     int most = 0;
     for (std::size_t k = 0; k < r.steps.size(); ++k) {
       auto& s = r.steps[k];
       auto it = by_iteration.find(s.iteration);
-      if (it != by_iteration.end()) s.gap = front_gap(s.front, it->second->front);
+      if (it != by_iteration.end()) {
+        s.gap = front_gap(s.front, it->second->front);
+        const double length_mean = 0.5 * (front_length(s.front) + front_length(it->second->front));
+        if (length_mean > 0) s.offset = (s.area - it->second->area) / length_mean;
+      }
       if (&r != band && k < band->steps.size()) {
         const FrontGap to_band = front_gap(s.front, band->steps[k].front);
         s.band_error = to_band.max / length;
         s.band_mean = to_band.mean / length;
         worst_band = std::max(worst_band, s.band_error);
+        worst_band_mean = std::max(worst_band_mean, s.band_mean);
       }
       worst = std::max(worst, s.gap.max / length);
       worst_mean = std::max(worst_mean, s.gap.mean / length);
@@ -182,15 +217,22 @@ int main(int argc, char** argv) {
       ms += s.ms;
       substeps += s.substeps;
       most = std::max(most, s.components);
-      csv << fmt::format("{},{},{},{},{},{},{:.9g},{:.1f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n", r.name, s.iteration,
-                         s.time, s.faces, s.substeps, s.components, s.area, s.ms, s.gap.mean / length,
-                         s.gap.p95 / length, s.gap.max / length, s.band_error, s.band_mean);
+      csv << fmt::format("{},{},{},{},{},{},{:.9g},{:.1f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n", r.name,
+                         s.iteration, s.time, s.faces, s.substeps, s.components, s.area, s.ms, s.gap.mean / length,
+                         s.gap.median / length, s.gap.p95 / length, s.gap.max / length, s.offset / length,
+                         s.band_error, s.band_mean);
     }
     const double n = std::max<std::size_t>(1, r.steps.size());
-    fmt::print("{:>10} {:>8.1f} {:>8.0f} {:>9.1f} {:>6} {:>5} |                                   {:>6.3f} {:>6.3f} {:>6.3f} | "
-               "{:>7.3f}\n",
+    const StepRecord last = r.steps.empty() ? StepRecord{} : r.steps.back();
+    fmt::print("{:>10} {:>8.1f} {:>8.0f} {:>9.1f} {:>6} {:>5} |                               {:>6.3f} {:>6.3f} {:>6.3f}  "
+               "      {:>6.3f} {:>+7.3f} |                {:>6.3f} {:>6.3f}\n",
                r.name, r.wall_s, ms / n, substeps / n, merge_step(r), most, worst_mean, worst_p95, worst,
-               &r == band ? 0.0 : worst_band);
+               last.gap.median / length, last.offset / length, worst_band_mean, worst_band);
+    if (!fronts_dir.empty())
+      for (const auto& s : r.steps) {
+        std::ofstream f(fronts_dir / fmt::format("{}_{:03d}.txt", r.name, s.iteration));
+        for (const auto& [a, b] : s.front) f << fmt::format("{} {} {} {} {} {}\n", a[0], a[1], a[2], b[0], b[1], b[2]);
+      }
   }
   fmt::print("wrote {}\n", csv_path.string());
   return 0;
