@@ -1,8 +1,9 @@
 // Accuracy and cost of the fire cases' CFL sub-steps: the narrow band against the whole surface
 // and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/performance.md).
 //
-//   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--iterations N]
-//                       [--reference-factor 4] [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]
+//   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--set key=value]...
+//                       [--iterations N] [--reference-factor 4] [--floor-perturbation 0.01]
+//                       [--fronts DIR] [-o out.csv]
 //
 // Runs the case from the same T^0 as "band" (the case as shipped: its max_cfl, sub-steps in a narrow
 // band), "whole" (the same sub-steps on the whole surface), "reference" (max_cfl divided by the
@@ -134,7 +135,7 @@ int merge_step(const Run& r) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) try {
   std::filesystem::path case_file = "meshes/cases/fire_four_disks.toml";
   double h = 0;
   int iterations = -1;
@@ -142,11 +143,14 @@ int main(int argc, char** argv) {
   double perturbation = 1e-2;
   std::filesystem::path fronts_dir;
   std::filesystem::path csv_path = "bench_fire_accuracy.csv";
+  std::vector<std::string> overrides;
   bench::Arguments args("bench_fire_accuracy",
-                        "usage: bench_fire_accuracy [--case file.toml] [--h H] [--iterations N] [--reference-factor 4] "
-                        "[--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]\n"
+                        "usage: bench_fire_accuracy [--case file.toml] [--h H] [--set key=value]... [--iterations N] "
+                        "[--reference-factor 4] [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]\n"
                         "  --case              fire case with max_cfl > 0 (default meshes/cases/fire_four_disks.toml)\n"
                         "  --h                 surface.h and remesh.hmax in metres (default: the case's)\n"
+                        "  --set               a case key for every run, as `bodyfit run --set` (repeatable), e.g.\n"
+                        "                      --set surface.max_height=750\n"
                         "  --iterations        steps to run (default: the case's final time)\n"
                         "  --reference-factor  the reference divides max_cfl by this (default 4)\n"
                         "  --floor-perturbation  the floor run (the band run on other meshes) multiplies hmax by\n"
@@ -155,6 +159,7 @@ int main(int argc, char** argv) {
                         "  -o                  CSV, one row per run and step (default bench_fire_accuracy.csv)\n");
   args.option("--case", case_file);
   args.option("--h", h);
+  args.option("--set", [&](const std::string& value) { overrides.push_back(value); });
   args.option("--iterations", iterations);
   args.option("--reference-factor", factor);
   args.option("--floor-perturbation", perturbation);
@@ -167,8 +172,10 @@ int main(int argc, char** argv) {
     args.fail("--fronts: no directory " + fronts_dir.string());
   spdlog::set_level(spdlog::level::warn);
 
-  std::vector<std::string> overrides;
-  if (h > 0) overrides = {fmt::format("surface.h={}", h), fmt::format("remesh.hmax={}", h)};
+  if (h > 0) {
+    overrides.push_back(fmt::format("surface.h={}", h));
+    overrides.push_back(fmt::format("remesh.hmax={}", h));
+  }
   const CaseConfig config = read_case(case_file, overrides);
   const double max_cfl = config.time.max_cfl;
   if (!(max_cfl > 0)) args.fail("the case has no max_cfl: nothing to compare");
@@ -236,4 +243,7 @@ int main(int argc, char** argv) {
   }
   fmt::print("wrote {}\n", csv_path.string());
   return 0;
+} catch (const std::exception& e) {  // a case that does not read, or a run that fails: say which, exit 1
+  fmt::print(stderr, "bench_fire_accuracy: {}\n", e.what());
+  return 1;
 }
