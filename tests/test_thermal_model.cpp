@@ -32,6 +32,7 @@ noise = 0.0        # strict Armijo: every accepted step decreases J
 [time]
 dt = 0.4
 iterations = 8
+max_rejections = 8  # near the optimum J falls by about the cut's noise at h = 0.15: up to 6 halvings
 [output]
 vtu_every = 0
 )";

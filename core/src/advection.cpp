@@ -461,11 +461,21 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
           break;
         }
       } else {
-        // Midpoint rule, x ← x − dt·V(x − dt/2·V(x)), with V at the midpoint taken from the affine
-        // velocity of x's face (extended beyond it when the midpoint lies outside).
+        // Midpoint rule, x ← x − dt·V(x − dt/2·V(x)). V at the midpoint from x's face while the
+        // midpoint lies in it; beyond its edges, from the face the midpoint lies in. Extending x's
+        // affine V there instead under-estimates a speed that grows along the path (the rate of
+        // spread up a steepening slope), and the feet of a sub-step crossing a few cells fell
+        // short: a fire's front lagged first order in the sub-step (docs/advection.md).
         Location mid = x;
         for (int i = 0; i < 3; ++i) mid.b[i] = x.b[i] - 0.5 * dt * k1.d[i];
-        const WalkEnd end = walk(s, x, (-dt) * velocity_at(s, mid), nullptr);
+        Delta k2;
+        if (mid.b[0] >= 0 && mid.b[1] >= 0 && mid.b[2] >= 0) {
+          k2 = velocity_at(s, mid);
+        } else if (!stage(x, (-0.5 * dt) * k1, k2)) {
+          r.stalled = !r.outside;
+          break;
+        }
+        const WalkEnd end = walk(s, x, (-dt) * k2, nullptr);
         if (end != WalkEnd::arrived) {
           (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
           break;
