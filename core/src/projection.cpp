@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 
 #include <tbb/parallel_invoke.h>
@@ -14,6 +15,18 @@
 namespace bodyfit {
 
 namespace detail {
+
+/// Bounding-volume hierarchy over boxes, shared by the surface and the polyline projections.
+struct BoxTree {
+  struct Node {
+    Vec3 lo, hi;
+    int left = -1, right = -1;  ///< children; -1 for a leaf
+    int begin = 0, end = 0;     ///< leaf range in `order`
+  };
+  std::vector<Node> nodes;
+  std::vector<int> order;  ///< primitive indices, leaves hold contiguous ranges
+  void build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
+};
 
 namespace {
 constexpr int kLeafSize = 4;
@@ -166,6 +179,8 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
 }
 
 
+ReferenceSurface::~ReferenceSurface() = default;
+
 std::shared_ptr<ReferenceSurface> ReferenceSurface::sphere(const Vec3& center, double radius) {
   std::shared_ptr<ReferenceSurface> s(new ReferenceSurface());
   s->is_sphere_ = true;
@@ -184,7 +199,8 @@ void ReferenceSurface::ensure_tree() const {
         hi[i].maximize(points_[tri_[i][k]]);
       }
     }
-    tree_.build(lo, hi);
+    tree_ = std::make_unique<detail::BoxTree>();
+    tree_->build(lo, hi);
   });
 }
 
@@ -217,10 +233,15 @@ SurfacePoint ReferenceSurface::closest(const Vec3& p, int hint) const {
     best2 *= 1 + 1e-12;  // keep the hint's value as a strict bound
   }
   ensure_tree();
-  detail::nearest(tree_, p, best2, consider);
+  detail::nearest(*tree_, p, best2, consider);
   out.normal = normal_[out.face];
   return out;
 }
+
+ReferencePolyline::ReferencePolyline() = default;
+ReferencePolyline::~ReferencePolyline() = default;
+ReferencePolyline::ReferencePolyline(ReferencePolyline&&) noexcept = default;
+ReferencePolyline& ReferencePolyline::operator=(ReferencePolyline&&) noexcept = default;
 
 void ReferencePolyline::add(const Vec3& a, const Vec3& b, int label) {
   a_.push_back(a);
@@ -325,7 +346,8 @@ void ReferencePolyline::ensure_tree() const {
         hi[i].maximize(q);
       }
   }
-  tree_.build(lo, hi);
+  if (!tree_) tree_ = std::make_unique<detail::BoxTree>();
+  tree_->build(lo, hi);
   built_ = true;
 }
 
@@ -333,7 +355,7 @@ Vec3 ReferencePolyline::closest(const Vec3& p, int label) const {
   ensure_tree();
   double best2 = std::numeric_limits<double>::max();
   Vec3 best = p;
-  detail::nearest(tree_, p, best2, [&](int i) {
+  detail::nearest(*tree_, p, best2, [&](int i) {
     if (label_[i] != label) return;
     Vec3 q = closest_on(std::size_t(i), p);
     double d2 = (q - p).sqrnorm();

@@ -11,18 +11,8 @@
 namespace bodyfit {
 
 namespace detail {
-/// Bounding-volume hierarchy over boxes (private layout shared by the two projections).
-struct BoxTree {
-  struct Node {
-    Vec3 lo, hi;
-    int left = -1, right = -1;  ///< children; -1 for a leaf
-    int begin = 0, end = 0;     ///< leaf range in `order`
-  };
-  std::vector<Node> nodes;
-  std::vector<int> order;  ///< primitive indices, leaves hold contiguous ranges
-  void build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
-};
-}  // namespace detail
+struct BoxTree;  // bounding-volume hierarchy of both projections (projection.cpp)
+}
 
 /// A point of S: position, unit normal of S there and the reference triangle (-1 when analytic).
 struct SurfacePoint {
@@ -36,6 +26,7 @@ class ReferenceSurface {
   /// Copy the triangles of `mesh` (non-deleted faces; face i of a garbage-collected mesh is
   /// reference triangle i). The search tree is built on the first query.
   explicit ReferenceSurface(const SurfaceMesh& mesh);
+  ~ReferenceSurface();
   /// Exact sphere: the projection is c + r (p − c)/|p − c|.
   static std::shared_ptr<ReferenceSurface> sphere(const Vec3& center, double radius);
 
@@ -56,13 +47,17 @@ class ReferenceSurface {
   std::vector<std::array<int, 3>> tri_;
   std::vector<Vec3> normal_;
   mutable std::once_flag tree_once_;
-  mutable detail::BoxTree tree_;
+  mutable std::unique_ptr<detail::BoxTree> tree_;
 };
 
 /// A set of segments, each with an integer label (e.g. the kind of curve); closest point among the
 /// segments carrying a given label.
 class ReferencePolyline {
  public:
+  ReferencePolyline();
+  ~ReferencePolyline();
+  ReferencePolyline(ReferencePolyline&&) noexcept;
+  ReferencePolyline& operator=(ReferencePolyline&&) noexcept;
   void add(const Vec3& a, const Vec3& b, int label);
   /// Closest point to p on the segments with `label`; returns p when there is none.
   Vec3 closest(const Vec3& p, int label) const;
@@ -88,7 +83,7 @@ class ReferencePolyline {
   std::vector<char> smooth_;
   std::vector<int> label_;
   mutable bool built_ = false;
-  mutable detail::BoxTree tree_;
+  mutable std::unique_ptr<detail::BoxTree> tree_;
 };
 
 /// Closest point to p on the triangle abc.
