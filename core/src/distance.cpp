@@ -1,6 +1,8 @@
 // Signed geodesic distance on a triangulated surface: exact initialisation next to the zero set of
 // the P1 level set, then fast marching (Kimmel–Sethian triangle update, obtuse angles split by
 // unfolding) over flat arrays.
+#include "distance_seeds.hpp"
+
 #include <bodyfit/distance.hpp>
 #include <bodyfit/error.hpp>
 
@@ -21,12 +23,7 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// Gram data of a corner: the triangle (x; a, b) seen from x, with ea = a − x, eb = b − x.
-struct CornerGeometry {
-  double aa = 0, bb = 0, ab = 0;  ///< |ea|², |eb|², ea·eb
-};
-
-CornerGeometry corner_geometry(const Vec3& ea, const Vec3& eb) { return {ea.sqrnorm(), eb.sqrnorm(), ea | eb}; }
+using namespace distance_detail;
 
 /// Planar-front update of x from the known values da at a and db at b (Kimmel–Sethian): the value
 /// t at x such that the linear interpolant of (t, da, db) has unit gradient and its characteristic
@@ -129,176 +126,6 @@ FrontValue front_update(const CornerGeometry& g, double da, double db, double ka
   return out;
 }
 
-/// For an obtuse corner: the vertex r found by unfolding the faces beyond the opposite edge that
-/// splits the angle into two acute ones, with the geometry of the virtual triangles (x; a, r) and
-/// (x; r, b).
-struct ObtuseSplit {
-  int corner = -1;  ///< 3f + c of the obtuse corner
-  int vertex = -1;  ///< r
-  CornerGeometry first, second;
-};
-
-/// One triangle of the fan around a vertex v: its two other vertices in order (v, a, b), the corner
-/// 3f + c of v, and which of the corners at a and b are obtuse (bits 1 and 2).
-struct FanTriangle {
-  int a = 0, b = 0;
-  int corner = 0;
-  std::uint8_t obtuse = 0;
-};
-
-/// The surface as flat arrays: the corners of each face, the face across the edge opposite each
-/// corner, and the fan of triangles around each vertex (CSR), which the marching loop reads
-/// sequentially.
-struct FlatMesh {
-  std::size_t nv = 0, nf = 0;
-  std::vector<Vec3> points;
-  std::vector<int> corner_vertex;   // 3f + c → vertex
-  std::vector<int> across;          // 3f + c → face across the edge opposite corner c, or −1
-  std::vector<int> obtuse;          // 3f + c → index into splits, −2 obtuse without split, −1 not obtuse
-  std::vector<ObtuseSplit> splits;
-  std::vector<int> split_start, split_list;  // vertex r → the splits that use it (CSR)
-  std::vector<int> fan_start;       // vertex → its fan triangles (CSR)
-  std::vector<FanTriangle> fan;
-};
-
-FlatMesh flatten(const SurfaceMesh& mesh) {
-  FlatMesh m;
-  m.nv = mesh.n_vertices();
-  m.nf = mesh.n_faces();
-  m.points.resize(m.nv);
-  for (std::size_t i = 0; i < m.nv; ++i) m.points[i] = mesh.point(VertexHandle(int(i)));
-  m.corner_vertex.resize(3 * m.nf);
-  m.across.resize(3 * m.nf);
-  m.obtuse.assign(3 * m.nf, -1);
-  for (std::size_t f = 0; f < m.nf; ++f) {
-    if (mesh.status(FaceHandle(int(f))).deleted())
-      throw InputError("signed_distance: the mesh must be garbage-collected");
-    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
-    const auto h1 = mesh.next_halfedge_handle(h0);
-    const auto h2 = mesh.next_halfedge_handle(h1);
-    m.corner_vertex[3 * f + 0] = mesh.from_vertex_handle(h0).idx();
-    m.corner_vertex[3 * f + 1] = mesh.to_vertex_handle(h0).idx();
-    m.corner_vertex[3 * f + 2] = mesh.to_vertex_handle(h1).idx();
-    // corner c is opposite the halfedge from corner c+1 to corner c+2
-    m.across[3 * f + 0] = mesh.opposite_face_handle(h1).idx();
-    m.across[3 * f + 1] = mesh.opposite_face_handle(h2).idx();
-    m.across[3 * f + 2] = mesh.opposite_face_handle(h0).idx();
-  }
-  return m;
-}
-
-/// The fans, after the obtuse corners are known.
-void build_fans(FlatMesh& m) {
-  m.split_start.assign(m.nv + 1, 0);
-  for (const auto& s : m.splits) ++m.split_start[s.vertex + 1];
-  for (std::size_t i = 0; i < m.nv; ++i) m.split_start[i + 1] += m.split_start[i];
-  m.split_list.resize(m.splits.size());
-  std::vector<int> next(m.split_start.begin(), m.split_start.end() - 1);
-  for (std::size_t i = 0; i < m.splits.size(); ++i) m.split_list[next[m.splits[i].vertex]++] = int(i);
-
-  m.fan_start.assign(m.nv + 1, 0);
-  for (int v : m.corner_vertex) ++m.fan_start[v + 1];
-  for (std::size_t i = 0; i < m.nv; ++i) m.fan_start[i + 1] += m.fan_start[i];
-  m.fan.resize(3 * m.nf);
-  std::vector<int> fill(m.fan_start.begin(), m.fan_start.end() - 1);
-  for (std::size_t k = 0; k < 3 * m.nf; ++k) {
-    const std::size_t f = k / 3, c = k % 3;
-    FanTriangle t;
-    t.a = m.corner_vertex[3 * f + (c + 1) % 3];
-    t.b = m.corner_vertex[3 * f + (c + 2) % 3];
-    t.corner = int(k);
-    t.obtuse = std::uint8_t((m.obtuse[3 * f + (c + 1) % 3] != -1 ? 1 : 0) | (m.obtuse[3 * f + (c + 2) % 3] != -1 ? 2 : 0));
-    m.fan[fill[m.corner_vertex[k]]++] = t;
-  }
-}
-
-/// Position of the third vertex of the triangle (p, q, r) unfolded into the plane of the 2-D points
-/// P, Q (p → P, q → Q), on the side opposite `away`.
-std::array<double, 2> unfold(const Vec3& p, const Vec3& q, const Vec3& r, std::array<double, 2> P,
-                             std::array<double, 2> Q, std::array<double, 2> away) {
-  const Vec3 e = q - p, w = r - p;
-  const double len2 = e.sqrnorm();
-  const double s = (w | e) / len2;                     // coordinate along pq
-  const double hgt = (w - e * s).norm();               // distance of r from the line pq
-  const std::array<double, 2> E{Q[0] - P[0], Q[1] - P[1]};
-  const double len = std::sqrt(E[0] * E[0] + E[1] * E[1]);
-  std::array<double, 2> n{-E[1] / len, E[0] / len};
-  if ((away[0] - P[0]) * n[0] + (away[1] - P[1]) * n[1] > 0) n = {-n[0], -n[1]};
-  return {P[0] + s * E[0] + hgt * n[0], P[1] + s * E[1] + hgt * n[1]};
-}
-
-/// Kimmel–Sethian unfolding for the obtuse corner k = 3f + c: walk across the faces beyond the
-/// opposite edge, unfolded into the plane of f, until a vertex falls in the section of the angle
-/// where both sub-angles are acute.
-void split_obtuse_corner(FlatMesh& m, int k) {
-  const int f = k / 3, c = k % 3;
-  const int xv = m.corner_vertex[k];
-  int pv = m.corner_vertex[3 * f + (c + 1) % 3], qv = m.corner_vertex[3 * f + (c + 2) % 3];
-  const Vec3& x = m.points[xv];
-  const Vec3 ea = m.points[pv] - x, eb = m.points[qv] - x;
-  const double la = ea.norm();
-  // 2-D frame: x at the origin, a on the first axis.
-  const std::array<double, 2> X{0, 0};
-  const double bx = (eb | ea) / la;
-  const std::array<double, 2> A0{la, 0}, B0{bx, (eb - ea * (bx / la)).norm()};
-  auto dot = [](std::array<double, 2> u, std::array<double, 2> v) { return u[0] * v[0] + u[1] * v[1]; };
-  std::array<double, 2> P = A0, Q = B0;
-  int face = f;
-  int far_corner = c;  // corner of `face` opposite the edge (pv, qv)
-  for (int step = 0; step < 16; ++step) {
-    const int next = m.across[3 * face + far_corner];
-    if (next < 0) return;
-    int rc = 0;  // the corner of `next` that is neither pv nor qv
-    for (int i = 0; i < 3; ++i) {
-      const int w = m.corner_vertex[3 * next + i];
-      if (w != pv && w != qv) rc = i;
-    }
-    const int rv = m.corner_vertex[3 * next + rc];
-    // The unfolded r lies on the side of pq away from x (x is on the near side for every strip face).
-    const std::array<double, 2> R = unfold(m.points[pv], m.points[qv], m.points[rv], P, Q, X);
-    // Acute section: r·a > 0 and r·b > 0 (both sub-angles below 90°).
-    const bool acute_a = dot(R, A0) > 0, acute_b = dot(R, B0) > 0;
-    if (acute_a && acute_b) {
-      const Vec3 ea3{A0[0], A0[1], 0}, eb3{B0[0], B0[1], 0}, er3{R[0], R[1], 0};
-      ObtuseSplit s;
-      s.corner = k;
-      s.vertex = rv;
-      s.first = corner_geometry(ea3, er3);
-      s.second = corner_geometry(er3, eb3);
-      m.obtuse[k] = int(m.splits.size());
-      m.splits.push_back(s);
-      return;
-    }
-    // Continue across the edge of `next` that the section crosses: if r is on a's side of the
-    // section (too close to a: r·b ≤ 0), the section lies between r and q.
-    face = next;
-    if (!acute_b) {
-      pv = rv;
-      P = R;
-    } else {
-      qv = rv;
-      Q = R;
-    }
-    for (int i = 0; i < 3; ++i) {
-      const int w = m.corner_vertex[3 * face + i];
-      if (w != pv && w != qv) far_corner = i;
-    }
-  }
-}
-
-void find_obtuse_corners(FlatMesh& m) {
-  for (std::size_t k = 0; k < 3 * m.nf; ++k) {
-    const int f = int(k / 3), c = int(k % 3);
-    const Vec3& x = m.points[m.corner_vertex[3 * f + c]];
-    const Vec3& a = m.points[m.corner_vertex[3 * f + (c + 1) % 3]];
-    const Vec3& b = m.points[m.corner_vertex[3 * f + (c + 2) % 3]];
-    if (((a - x) | (b - x)) < 0) {
-      m.obtuse[k] = -2;  // obtuse, no split found (yet)
-      split_obtuse_corner(m, int(k));
-    }
-  }
-}
-
 double point_segment_distance(const Vec3& p, const Vec3& a, const Vec3& b) {
   const Vec3 e = b - a;
   const double len2 = e.sqrnorm();
@@ -333,173 +160,11 @@ double curvature_seen_from(const Vec3& p, const Vec3& a, const Vec3& b, const Ve
   return length > 0 ? -((ka * (1 - t) + kb * t) | away) / length : 0.0;
 }
 
-/// What the initialisation needs: the sign of each vertex (−1, 0, +1) and, for every face touched
-/// by the interface, the interface segments inside it.
-struct Seeds {
-  std::vector<signed char> sign;
-  std::vector<int> zeros;                       // the vertices on the zero set (sign 0)
-  std::vector<int> faces;                       // seed faces
-  std::vector<int> seg_start;                   // per seed face, into segments (CSR)
-  std::vector<std::pair<Vec3, Vec3>> segments;  // a point is a segment with equal ends
-  std::vector<std::pair<Vec3, Vec3>> bends;     // empty, or per segment the curvature vectors at its ends
-};
-
-/// The zero set of φ in face f, appended to s as one seed face when φ vanishes there.
-void add_phi_seed(const FlatMesh& m, const ScalarField& phi, int f, Seeds& s) {
-  auto sign = [&](int v) { return phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0; };
-  std::array<Vec3, 3> zero;
-  int count = 0;
-  for (int c = 0; c < 3; ++c) {
-    const int a = m.corner_vertex[3 * f + c], b = m.corner_vertex[3 * f + (c + 1) % 3];
-    if (sign(a) == 0) zero[count++] = m.points[a];
-    if (sign(a) * sign(b) < 0) {
-      const double t = phi[a] / (phi[a] - phi[b]);  // scale-free
-      zero[count++] = m.points[a] + (m.points[b] - m.points[a]) * t;
-    }
-  }
-  if (count == 0) return;
-  s.faces.push_back(f);
-  if (count == 1) s.segments.emplace_back(zero[0], zero[0]);
-  else if (count == 2) s.segments.emplace_back(zero[0], zero[1]);
-  else
-    for (int i = 0; i < 3; ++i) s.segments.emplace_back(zero[i], zero[(i + 1) % 3]);
-  s.seg_start.push_back(int(s.segments.size()));
-}
-
-Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
-  Seeds s;
-  s.sign.resize(m.nv);
-  for (std::size_t v = 0; v < m.nv; ++v) {
-    s.sign[v] = phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0;
-    if (s.sign[v] == 0) s.zeros.push_back(int(v));
-  }
-  s.seg_start.push_back(0);
-  for (std::size_t f = 0; f < m.nf; ++f) add_phi_seed(m, phi, int(f), s);
-  return s;
-}
-
-/// Curvature vector of the interface curve (towards the centre of the circle through a vertex and
-/// its two interface neighbours, projected on the tangent plane of S: the geodesic curvature) at
-/// each interface vertex where the curve is smooth. `smooth` is false at the vertices of
-/// interface-degree ≠ 2, on the boundary of S, or where the curve turns by more than 30°.
-void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector<Vec3>& curvature,
-                         std::vector<char>& smooth) {
-  std::vector<std::array<int, 2>> neighbour(m.nv, {-1, -1});
-  std::vector<int> degree(m.nv, 0);
-  for (auto e : mesh.edges()) {
-    if (!mesh.interface(e)) continue;
-    const auto h = mesh.halfedge_handle(e, 0);
-    const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-    if (degree[a] < 2) neighbour[a][degree[a]] = b;
-    if (degree[b] < 2) neighbour[b][degree[b]] = a;
-    ++degree[a];
-    ++degree[b];
-  }
-  const double cos_max_turn = std::cos(std::numbers::pi / 6);
-  curvature.assign(m.nv, Vec3(0, 0, 0));
-  smooth.assign(m.nv, 0);
-  for (std::size_t v = 0; v < m.nv; ++v) {
-    if (degree[v] != 2 || mesh.is_boundary(VertexHandle(int(v)))) continue;
-    const Vec3& x = m.points[v];
-    const Vec3 u = m.points[neighbour[v][0]] - x, w = m.points[neighbour[v][1]] - x;
-    // The turn between the segments (x − u-end) and (w-end − x) has cosine −u·w / (|u||w|).
-    if (-(u | w) < cos_max_turn * u.norm() * w.norm()) continue;
-    smooth[v] = 1;
-    const Vec3 uw = u % w;
-    const double uw2 = uw.sqrnorm();
-    if (uw2 == 0) continue;  // collinear: straight
-    const Vec3 centre = ((w * u.sqrnorm() - u * w.sqrnorm()) % uw) / (2 * uw2);  // circumcentre − x
-    Vec3 k = centre / centre.sqrnorm();
-    Vec3 normal(0, 0, 0);
-    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
-      normal += (m.points[m.fan[j].a] - x) % (m.points[m.fan[j].b] - x);
-    const double length = normal.norm();
-    if (length > 0) {
-      normal /= length;
-      k -= normal * (k | normal);
-    }
-    curvature[v] = k;
-  }
-}
-
-Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved) {
-  Seeds s;
-  std::vector<Vec3> curvature;
-  std::vector<char> smooth;
-  if (curved) interface_curvature(mesh, m, curvature, smooth);
-  const Vec3 zero(0, 0, 0);
-  // An interface edge bends only when both its ends are smooth curve points.
-  auto add_segment = [&](int a, int b) {
-    s.segments.emplace_back(m.points[a], m.points[b]);
-    if (!curved) return;
-    if (a != b && smooth[a] && smooth[b]) s.bends.emplace_back(curvature[a], curvature[b]);
-    else s.bends.emplace_back(zero, zero);
-  };
-  s.sign.assign(m.nv, 1);
-  for (std::size_t f = 0; f < m.nf; ++f)
-    if (mesh.inside(FaceHandle(int(f))))
-      for (int c = 0; c < 3; ++c) s.sign[m.corner_vertex[3 * f + c]] = -1;
-  std::vector<char> on_interface(m.nv, 0);
-  for (auto e : mesh.edges()) {
-    if (!mesh.interface(e)) continue;
-    const auto h = mesh.halfedge_handle(e, 0);
-    on_interface[mesh.from_vertex_handle(h).idx()] = 1;
-    on_interface[mesh.to_vertex_handle(h).idx()] = 1;
-  }
-  for (std::size_t v = 0; v < m.nv; ++v)
-    if (on_interface[v]) {
-      s.sign[v] = 0;
-      s.zeros.push_back(int(v));
-    }
-  s.seg_start.push_back(0);
-  for (std::size_t f = 0; f < m.nf; ++f) {
-    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
-    bool seed = false;
-    for (auto h : {h0, mesh.next_halfedge_handle(h0), mesh.prev_halfedge_handle(h0)}) {
-      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-      if (mesh.interface(mesh.edge_handle(h))) {
-        add_segment(a, b);
-        seed = true;
-      } else if (on_interface[a]) {
-        add_segment(a, a);
-        seed = true;
-      }
-    }
-    if (!seed) continue;
-    s.faces.push_back(int(f));
-    s.seg_start.push_back(int(s.segments.size()));
-  }
-  return s;
-}
-
 constexpr int kNearRings = 3;
 constexpr double kNearRadius = 2.5;
 
 using HeapEntry = std::pair<double, int>;
 using MinHeap = std::priority_queue<HeapEntry, std::vector<HeapEntry>, std::greater<>>;
-
-/// Discrete Gaussian curvature at each vertex: angle defect over a third of the incident area
-/// (0 on the boundary, where the defect measures the boundary's turning instead).
-std::vector<double> gaussian_curvature(const FlatMesh& m) {
-  std::vector<double> angle(m.nv, 0.0), area(m.nv, 0.0);
-  std::vector<char> boundary(m.nv, 0);
-  for (std::size_t f = 0; f < m.nf; ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int v = m.corner_vertex[3 * f + c];
-      const Vec3& p = m.points[v];
-      const Vec3 u = m.points[m.corner_vertex[3 * f + (c + 1) % 3]] - p, w = m.points[m.corner_vertex[3 * f + (c + 2) % 3]] - p;
-      angle[v] += std::atan2((u % w).norm(), u | w);
-      area[v] += (u % w).norm() / 6;
-      if (m.across[3 * f + c] < 0) {  // the edge opposite c is a boundary edge: both its ends are
-        boundary[m.corner_vertex[3 * f + (c + 1) % 3]] = 1;
-        boundary[m.corner_vertex[3 * f + (c + 2) % 3]] = 1;
-      }
-    }
-  std::vector<double> gauss(m.nv, 0.0);
-  for (std::size_t v = 0; v < m.nv; ++v)
-    if (!boundary[v] && area[v] > 0) gauss[v] = (2 * std::numbers::pi - angle[v]) / area[v];
-  return gauss;
-}
 
 /// The march's per-vertex arrays, kept between the calls of a DistanceSolver so that a narrow-band
 /// call touches only the band: `touched` lists the vertices whose entries differ from the initial
@@ -727,12 +392,6 @@ void check_level_set(const SurfaceMesh& mesh, const ScalarField& phi) {
     if (!std::isfinite(value)) throw InputError("signed_distance: the level set has a non-finite value");
 }
 
-FlatMesh prepared_mesh(const SurfaceMesh& mesh) {
-  FlatMesh m = flatten(mesh);
-  find_obtuse_corners(m);
-  build_fans(m);
-  return m;
-}
 
 }  // namespace
 
