@@ -94,18 +94,9 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
   };
   while (!ended) {
     if (!in.skip_blank()) break;
-    const long keyword_line = in.line();
-    if (!in.next_is_word()) {
-      auto token = in.word();
-      throw file_error(file, keyword_line,
-                       fmt::format("expected a keyword, found '{}' (more records than the section's count?)",
-                                   token.substr(0, 40)));
-    }
-    auto word = in.word();
+    const std::string_view word = in.keyword("records");
     if (word == "MeshVersionFormatted") {
-      header.version = int(in.integer("the version number"));
-      if (header.version < 1 || header.version > 4)
-        throw in.error(fmt::format("unsupported MeshVersionFormatted {} (expected 1 to 4)", header.version));
+      header.version = in.format_version();
     } else if (word == "Dimension") {
       header.dimension = int(in.integer("the dimension"));
       check_dimension(header.dimension, [&](const std::string& w) { return in.error(w); });

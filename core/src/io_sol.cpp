@@ -53,17 +53,9 @@ SolRead read_sol_text(std::string_view text, const fs::path& file) {
   bool versioned = false;
   while (in.skip_blank()) {
     const long keyword_line = in.line();
-    if (!in.next_is_word()) {
-      auto token = in.word();
-      throw file_error(file, keyword_line,
-                       fmt::format("expected a keyword, found '{}' (more values than the section's count?)",
-                                   token.substr(0, 40)));
-    }
-    auto word = in.word();
+    const std::string_view word = in.keyword("values");
     if (word == "MeshVersionFormatted") {
-      int version = int(in.integer("the version number"));
-      if (version < 1 || version > 4)
-        throw in.error(fmt::format("unsupported MeshVersionFormatted {} (expected 1 to 4)", version));
+      in.format_version();
       versioned = true;
     } else if (word == "Dimension") {
       dimension = int(in.integer("the dimension"));

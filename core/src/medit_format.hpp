@@ -109,6 +109,25 @@ class TextScanner {
     return skip_blank() && ((*p_ >= 'A' && *p_ <= 'Z') || (*p_ >= 'a' && *p_ <= 'z'));
   }
 
+  /// The keyword of the next section, after skip_blank(). A number there is an error: the section
+  /// before held more `records` than its count said.
+  std::string_view keyword(const char* records) {
+    if (!next_is_word()) {
+      const std::string_view token = word();
+      throw error(fmt::format("expected a keyword, found '{}' (more {} than the section's count?)", token.substr(0, 40),
+                              records));
+    }
+    return word();
+  }
+
+  /// The number after MeshVersionFormatted: 1 to 4.
+  int format_version() {
+    const std::int64_t version = integer("the version number");
+    if (version < 1 || version > 4)
+      throw error(fmt::format("unsupported MeshVersionFormatted {} (expected 1 to 4)", version));
+    return int(version);
+  }
+
   std::int64_t integer(const char* what) {
     if (!skip_blank()) throw eof(what);
     const char* start = p_;
