@@ -108,6 +108,26 @@ TEST_CASE("vertex gradients: exact for an affine function on a plane, tangential
   CHECK(std::log(coarse / fine) / std::log(2.0) > 0.9);  // h halves from 1280 to 5120 faces
 }
 
+TEST_CASE("vertex gradients at some vertices are the whole-surface ones bit for bit, zero elsewhere") {
+  // A narrow band computes the front's normal at its own vertices only; it must see the values the
+  // whole surface does, to the last bit, or the two computations part by rounding.
+  const SurfaceMesh sphere = make_sphere({.faces = 1280});
+  ScalarField u(sphere.n_vertices());
+  for (auto v : sphere.vertices()) u[v.idx()] = std::sin(3 * sphere.point(v)[0]) + sphere.point(v)[1] * sphere.point(v)[2];
+  const VectorField all = vertex_gradients(sphere, u);
+  std::vector<int> some;
+  for (int v = 0; v < int(sphere.n_vertices()); v += 3) some.push_back(v);
+  const VectorField part = vertex_gradients(sphere, u, some);
+  std::size_t same = 0, zero = 0;
+  for (int v = 0; v < int(sphere.n_vertices()); ++v)
+    if (v % 3 == 0)
+      same += part[v] == all[v];
+    else
+      zero += part[v] == Vec3(0, 0, 0);
+  CHECK(same == some.size());
+  CHECK(zero == sphere.n_vertices() - some.size());
+}
+
 TEST_CASE("z_order is a deterministic permutation that keeps consecutive points close") {
   // Points of a 32 × 32 × 32 lattice in a scrambled order: consecutive points in the scrambled order
   // are far apart; in Z-order they are neighbours most of the time.

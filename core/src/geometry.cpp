@@ -88,36 +88,80 @@ VectorField face_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
   return grads;
 }
 
+namespace {
+
+/// What face f adds at each of its corners to vertex_gradients: 2·area·∇u, its normal (2·area
+/// long) and 2·area; nothing for a degenerate face.
+struct CornerShare {
+  VertexHandle corners[3];
+  Vec3 weighted_gradient, normal;
+  double twice_area = 0;
+};
+
+bool corner_share(const SurfaceMesh& mesh, FaceHandle f, const ScalarField& u, CornerShare& share) {
+  auto h = mesh.halfedge_handle(f);
+  share.corners[0] = mesh.to_vertex_handle(h);
+  share.corners[1] = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
+  share.corners[2] = mesh.from_vertex_handle(h);
+  const Vec3 &a = mesh.point(share.corners[0]), &b = mesh.point(share.corners[1]), &c = mesh.point(share.corners[2]);
+  share.normal = OpenMesh::cross(b - a, c - a);
+  const double twice_area_sq = share.normal.sqrnorm();
+  if (twice_area_sq <= 0) return false;
+  // 2·area·∇u = n × (u_a (c − b) + u_b (a − c) + u_c (b − a)) / |n|.
+  share.weighted_gradient = OpenMesh::cross(share.normal, u[share.corners[0].idx()] * (c - b) +
+                                                              u[share.corners[1].idx()] * (a - c) +
+                                                              u[share.corners[2].idx()] * (b - a)) /
+                            std::sqrt(twice_area_sq);
+  share.twice_area = std::sqrt(twice_area_sq);
+  return true;
+}
+
+Vec3 averaged_tangent_gradient(const Vec3& sum, const Vec3& normal, double weight) {
+  if (!(weight > 0)) return Vec3(0, 0, 0);
+  const double len = normal.norm();
+  return project_tangent(sum / weight, len > 0 ? normal / len : normal);
+}
+
+}  // namespace
+
 VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
   // One pass over the faces, scattering to the corners: the area-weighted sum of the face
   // gradients and the area-weighted normal (|cross| = 2·area weights both alike).
   const std::size_t nv = mesh.n_vertices();
   VectorField sum(nv, Vec3(0, 0, 0)), normal(nv, Vec3(0, 0, 0));
   std::vector<double> weight(nv, 0.0);
+  CornerShare share;
   for (auto f : mesh.faces()) {
-    auto h = mesh.halfedge_handle(f);
-    const VertexHandle v[3] = {mesh.to_vertex_handle(h), mesh.to_vertex_handle(mesh.next_halfedge_handle(h)),
-                               mesh.from_vertex_handle(h)};
-    const Vec3 &a = mesh.point(v[0]), &b = mesh.point(v[1]), &c = mesh.point(v[2]);
-    const Vec3 n = OpenMesh::cross(b - a, c - a);
-    const double twice_area_sq = n.sqrnorm();
-    if (twice_area_sq <= 0) continue;
-    // 2·area·∇u = n × (u_a (c − b) + u_b (a − c) + u_c (b − a)) / |n|.
-    const Vec3 weighted_gradient =
-        OpenMesh::cross(n, u[v[0].idx()] * (c - b) + u[v[1].idx()] * (a - c) + u[v[2].idx()] * (b - a)) /
-        std::sqrt(twice_area_sq);
-    const double twice_area = std::sqrt(twice_area_sq);
-    for (const VertexHandle& w : v) {
-      sum[w.idx()] += weighted_gradient;
-      normal[w.idx()] += n;
-      weight[w.idx()] += twice_area;
+    if (!corner_share(mesh, f, u, share)) continue;
+    for (const VertexHandle& w : share.corners) {
+      sum[w.idx()] += share.weighted_gradient;
+      normal[w.idx()] += share.normal;
+      weight[w.idx()] += share.twice_area;
     }
   }
   VectorField result(nv, Vec3(0, 0, 0));
-  for (std::size_t i = 0; i < nv; ++i) {
-    if (!(weight[i] > 0)) continue;
-    const double len = normal[i].norm();
-    result[i] = project_tangent(sum[i] / weight[i], len > 0 ? normal[i] / len : normal[i]);
+  for (std::size_t i = 0; i < nv; ++i) result[i] = averaged_tangent_gradient(sum[i], normal[i], weight[i]);
+  return result;
+}
+
+VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u, std::span<const int> vertices) {
+  VectorField result(mesh.n_vertices(), Vec3(0, 0, 0));
+  std::vector<FaceHandle> faces;
+  CornerShare share;
+  for (int i : vertices) {
+    const VertexHandle v(i);
+    faces.clear();
+    for (FaceHandle f : mesh.vf_range(v)) faces.push_back(f);
+    std::sort(faces.begin(), faces.end());  // the scatter's order: by face index
+    Vec3 sum(0, 0, 0), normal(0, 0, 0);
+    double weight = 0;
+    for (FaceHandle f : faces) {
+      if (!corner_share(mesh, f, u, share)) continue;
+      sum += share.weighted_gradient;
+      normal += share.normal;
+      weight += share.twice_area;
+    }
+    result[std::size_t(i)] = averaged_tangent_gradient(sum, normal, weight);
   }
   return result;
 }

@@ -138,8 +138,9 @@ const VectorField& StepContext::conormal() const {
       n = bodyfit::vertex_gradients(mesh(), distance());
       for (auto& g : n) g = unit(g);
     } else {
-      n.assign(mesh().n_vertices(), Vec3(0, 0, 0));
-      for (int v : active) n[v] = unit(bodyfit::vertex_gradient(mesh(), VertexHandle(v), distance()));
+      // The whole-surface values, bit for bit: a band then gives the same front as the whole surface.
+      n = bodyfit::vertex_gradients(mesh(), distance(), active);
+      for (int v : active) n[v] = unit(n[v]);
     }
     impl_->conormal = std::move(n);
   }

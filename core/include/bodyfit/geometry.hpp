@@ -4,6 +4,7 @@
 #include <bodyfit/mesh.hpp>
 
 #include <array>
+#include <span>
 #include <functional>
 #include <utility>
 #include <vector>
@@ -35,6 +36,9 @@ VectorField face_gradients(const SurfaceMesh& mesh, const ScalarField& u);
 /// Per-vertex gradients: area-weighted average of the face gradients around each vertex, then
 /// projected on the vertex's tangent plane (vertex_normal).
 VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u);
+/// The same at `vertices` only (zero elsewhere), bit for bit: each vertex sums its faces in the order
+/// of vertex_gradients, so that a narrow band sees the values of the whole-surface computation.
+VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u, std::span<const int> vertices);
 /// The same at one vertex (for a few vertices; vertex_gradients is one pass over all faces).
 Vec3 vertex_gradient(const SurfaceMesh& mesh, VertexHandle v, const ScalarField& u);
 /// v − (v·n) n.
