@@ -176,6 +176,52 @@ TEST_CASE("sphere cap: topology, regions, quality, surface and interface accurac
         CHECK(std::abs(beta(mesh.point(v)) - radius) < h * h);
 }
 
+TEST_CASE("hausd_interface bounds the interface alone: its edges shorten to the chord of that sag, the rest keeps hmax") {
+  // The cap's circle (β = π/4 on the unit sphere) has curvature 1/sin β = √2. At the default hausd
+  // (D/1000 = 3.5e-3) its chords of h ≈ 0.054 sag by h²κ/8 = 5e-4: hmax suffices. With
+  // hausd_interface = 2e-5 the interface's target size is √(8·2e-5/√2) = 0.0106, and its edges may
+  // reach √2 times that before a split.
+  auto remeshed = [](double hausd_interface, double& h) {
+    auto mesh = make_sphere({.faces = 5120});
+    h = edge_length_stats(mesh).mean;
+    DiscretizeOptions cut;
+    cut.snap_ratio = 0;
+    discretize(mesh, cap_phi(mesh, M_PI / 4), cut);
+    RemeshOptions options;
+    options.hmax = h;
+    options.hausd_interface = hausd_interface;
+    options.reference = ReferenceSurface::sphere(Vec3(0, 0, 0), 1);
+    remesh(mesh, options);
+    return mesh;
+  };
+  double h = 0;
+  const SurfaceMesh loose = remeshed(0, h), tight = remeshed(2e-5, h);
+  auto interface_edges = [](const SurfaceMesh& mesh, double& longest) {
+    std::size_t count = 0;
+    longest = 0;
+    for (auto e : mesh.edges())
+      if (mesh.interface(e)) ++count, longest = std::max(longest, edge_length(mesh, e));
+    return count;
+  };
+  double longest_loose = 0, longest_tight = 0;
+  const std::size_t n_loose = interface_edges(loose, longest_loose), n_tight = interface_edges(tight, longest_tight);
+  const double target = std::sqrt(8 * 2e-5 / std::sqrt(2.0));
+  MESSAGE("interface edges " << n_loose << " -> " << n_tight << ", longest " << longest_loose << " -> " << longest_tight
+                             << " (target " << target << ")");
+  CHECK(longest_tight <= std::sqrt(2.0) * target * 1.05);
+  CHECK(longest_loose > 3 * longest_tight);
+  CHECK(n_tight > 3 * n_loose);
+  // The same circle and regions, a valid mesh, and the surface away from the front at hmax.
+  ValidateOptions vo;
+  vo.euler_characteristic = 2;
+  vo.boundary_loops = 0;
+  CHECK(problems(tight, vo) == "");
+  CHECK(interface_curves(tight).closed == 1);
+  CHECK(std::abs(interface_length(tight) - 2 * M_PI * std::sin(M_PI / 4)) < 2 * M_PI * h * h);
+  CHECK(edge_length_stats(tight).max <= std::sqrt(2.0) * h * 1.05);
+  CHECK(tight.n_faces() < loose.n_faces() * 3);
+}
+
 TEST_CASE("interface vertices stay on the smooth curve through the input interface, regions keep their labels") {
   auto mesh = make_grid(30, 1.0, true);
   ScalarField phi(mesh.n_vertices());

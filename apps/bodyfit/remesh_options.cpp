@@ -10,6 +10,9 @@ void add_remesh_options(CLI::App& command, RemeshOptions& options) {
       ->check(finite_above(0));
   command.add_option("--hausd", options.hausd, "allowed distance to the surface and interface (default diagonal/1000)")
       ->check(finite_above(0));
+  command.add_option("--hausd-interface", options.hausd_interface,
+                     "allowed distance to the interface curve alone (default --hausd)")
+      ->check(finite_above(0));
   command.add_option("--hgrad", options.hgrad, "gradation between neighbouring sizes, ≥ 1")
       ->capture_default_str()
       ->check(finite_at_least(1));

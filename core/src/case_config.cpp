@@ -257,6 +257,7 @@ void parse_stages(const toml::table& table, CaseConfig& config) {
     out.hmin = p.number("hmin", out.hmin, kPositive);
     out.hmax = p.number("hmax", out.hmax, kPositive);
     out.hausd = p.number("hausd", out.hausd, kPositive);
+    out.hausd_interface = p.number("hausd_interface", out.hausd_interface, kPositive);
     out.hgrad = p.number("hgrad", out.hgrad, {.min = 1});
     config.remesh_angle_given = p.has("angle");
     out.feature_angle = p.number("angle", out.feature_angle);

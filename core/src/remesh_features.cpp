@@ -21,6 +21,7 @@ void Remesher::setup_sizes() {
     hmax_ = hmin_;
   }
   hausd_ = opt_.hausd > 0 ? opt_.hausd : diag / 1000;
+  interface_hausd_ = opt_.hausd_interface > 0 ? opt_.hausd_interface : hausd_;
   corner_angle_ = (opt_.feature_angle > 0 ? opt_.feature_angle : 45.0) * M_PI / 180.0;
 }
 
@@ -167,8 +168,8 @@ void Remesher::classify_vertex(VertexHandle v) {
 
 void Remesher::compute_sizing() {
   // h ≤ sqrt(8 hausd / κ): the sag of a chord of length h on a curve of curvature κ is h²κ/8.
-  auto size_for = [&](double kappa) {
-    double h = kappa > 0 ? std::sqrt(8 * hausd_ / kappa) : hmax_;
+  auto size_for = [&](double kappa, double tolerance) {
+    double h = kappa > 0 ? std::sqrt(8 * tolerance / kappa) : hmax_;
     return std::clamp(h, hmin_, hmax_);
   };
   double kappa_sphere = 0;
@@ -219,7 +220,8 @@ void Remesher::compute_sizing() {
         if (denom > 0) kappa = std::max(kappa, 2 * (a % b).norm() / denom);
       }
     }
-    double h = size_for(kappa);
+    const bool on_interface = kind == kCurveVertex && m_.property(vcurve_, v) == kInterfaceCurve;
+    double h = size_for(kappa, on_interface ? interface_hausd_ : hausd_);
     m_.property(size_, v) = h;
     if (h < hmax_) uniform = false;
   });

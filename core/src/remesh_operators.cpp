@@ -141,18 +141,20 @@ bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std
   return false;
 }
 
-// Whether the curve stays within hausd of the curve vertex v0 when it collapses along h onto v1:
-// the new curve edge (u, v1), u the other curve neighbour of v0, must pass within hausd of v0.
+// Whether the curve stays within hausd (the interface: hausd_interface) of the curve vertex v0 when
+// it collapses along h onto v1: the new curve edge (u, v1), u the other curve neighbour of v0, must
+// pass within that distance of v0.
 bool Remesher::curve_collapse_within_hausd(HalfedgeHandle h) const {
   auto v0 = m_.from_vertex_handle(h), v1 = m_.to_vertex_handle(h);
   char curve = m_.property(vcurve_, v0);
+  const double tolerance = curve == kInterfaceCurve ? interface_hausd_ : hausd_;
   for (auto hu : m_.voh_range(v0)) {
     auto u = m_.to_vertex_handle(hu);
     if (u == v1 || m_.property(ecurve_, m_.edge_handle(hu)) != curve) continue;
     const Vec3 &a = m_.point(u), &b = m_.point(v1), &p = m_.point(v0);
     Vec3 ab = b - a;
     double t = ab.sqrnorm() > 0 ? std::clamp(((p - a) | ab) / ab.sqrnorm(), 0.0, 1.0) : 0.0;
-    if ((a + ab * t - p).norm() > hausd_) return false;
+    if ((a + ab * t - p).norm() > tolerance) return false;
   }
   return true;
 }

@@ -269,7 +269,7 @@ class Remesher {
   RemeshOptions opt_;
   std::shared_ptr<const ReferenceSurface> ref_;
   ReferencePolyline curves_;
-  double hmin_ = 0, hmax_ = 0, hausd_ = 0, corner_angle_ = 0;
+  double hmin_ = 0, hmax_ = 0, hausd_ = 0, interface_hausd_ = 0, corner_angle_ = 0;
   RemeshReport report_;
 
   OpenMesh::VPropHandleT<double> size_;

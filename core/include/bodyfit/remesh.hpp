@@ -25,6 +25,10 @@ struct RemeshOptions {
   double hmin = 0;      ///< smallest edge length (default hmax / 20)
   double hmax = 0;      ///< largest edge length (default resolution_length(mesh), geometry.hpp)
   double hausd = 0;     ///< allowed distance to the true surface and interface (default D / 1000)
+  /// Allowed distance to the interface curve alone (default hausd). An evolving front is cut and
+  /// remeshed every step, and each remesh may move it by this much: a moving front wants a tighter
+  /// bound than the surface's geometry does (docs/fire.md, "The floor and the interface's tolerance").
+  double hausd_interface = 0;
   double hgrad = 1.3;   ///< max ratio of target sizes between neighbouring vertices
   double feature_angle = 45;  ///< dihedral angle (degrees) above which an edge is a ridge, if S's normals
                               ///< across it differ as much; ≤ 0: none
