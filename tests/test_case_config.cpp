@@ -77,6 +77,8 @@ TEST_CASE("a valid case is read into its options") {
   CHECK(c.time.max_cfl == 0);  // no sub-steps unless asked for
   CHECK(parse(kValidCase, {"time.max_cfl=4"}).time.max_cfl == 4);
   CHECK(c.remesh.hmax == 0.2);
+  CHECK(c.remesh.hausd_interface == 0);  // the interface's tolerance is hausd unless given
+  CHECK(parse(kValidCase, {"remesh.hausd_interface=0.001"}).remesh.hausd_interface == 0.001);
   CHECK(c.output.vtu_every == 1);
 }
 
@@ -136,6 +138,8 @@ TEST_CASE("wrong types and values are errors naming the key") {
   CHECK_MESSAGE(contains(e, "[output] vtu_every: expected an integer"), e);
   e = error_of(kValidCase, {"remesh.hmax=-1"});
   CHECK_MESSAGE(contains(e, "[remesh] hmax: -1 is out of range (0, inf)"), e);
+  e = error_of(kValidCase, {"remesh.hausd_interface=0"});
+  CHECK_MESSAGE(contains(e, "[remesh] hausd_interface: 0 is out of range (0, inf)"), e);
   e = error_of(kValidCase, {"region.axis=[1, 2]"});
   CHECK_MESSAGE(contains(e, "[region] axis: expected 3 numbers, got 2"), e);
   e = error_of(kValidCase, {"surface.extent=5"});
