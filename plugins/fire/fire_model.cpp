@@ -111,6 +111,9 @@ class FireModel final : public VelocityModel {
         {"u0", "39.8", "combustion gas velocity, m/s"},
         {"v0", "12*R0", "flame-base velocity, m/s"},
         {"max_tilt_deg", "80", "cap on the tilt angle γ, degrees (< 90)"},
+        {"front_velocity", "\"huygens\"", "huygens: V = R n_Σ + (dR/dθ) t, along the front's characteristics "
+                                          "(Huygens' principle); normal: V = R n_Σ as in the paper. The same front "
+                                          "as the steps shrink; huygens is closer at a given step"},
         {"wind.type", "\"none\"", "none | uniform | rotating | grid | series | grid_series"},
         {"wind.velocity", "[0, 0]", "uniform wind (x, y), m/s"},
         {"wind.speed, wind.direction_deg", "", "uniform wind as speed (m/s) and the direction it blows from (degrees "
@@ -150,6 +153,7 @@ class FireModel final : public VelocityModel {
     base_.u0 = p.number("u0", base_.u0, {.min = 0, .min_exclusive = true});
     base_.v0 = p.number("v0", 12 * base_.R0, {.min = 0, .min_exclusive = true});
     base_.max_tilt = p.number("max_tilt_deg", 80, {.min = 0, .max = 90, .min_exclusive = true, .max_exclusive = true}) * kDegree;
+    huygens_ = p.choice("front_velocity", "huygens", {"huygens", "normal"}) == "huygens";
 
     if (const toml::table* wind = p.table("wind"))
       wind_ = read_wind_table(*wind, [&](const std::filesystem::path& file) {
@@ -261,12 +265,11 @@ class FireModel final : public VelocityModel {
       if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
       mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
     }
-    auto rate_at = [&](int v) {
+    auto rate_in = [&](int v, const Vec3& n_sigma) {
       if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
       const Vec3& x = mesh.point(VertexHandle(v));
       const BalbiParameters* fuel = fuel_at(x);
       if (!fuel) return 0.0;  // not burnable: the front stops here
-      const Vec3& n_sigma = conormal[v];
       if (n_sigma.sqrnorm() == 0) return fuel->R0;
       const Vec3& normal = normals[v];
       // ∇_S s · n_Σ = e3 · n_Σ because n_Σ is tangent (∇_S s = e3 − (e3·N)N).
@@ -275,10 +278,34 @@ class FireModel final : public VelocityModel {
       double tan_gamma = tan_tilt(slope_term, std::abs(normal[2]), wind_term, *fuel);
       return rate_of_spread(std::atan(tan_gamma), *fuel);
     };
+    auto rate_at = [&](int v) { return rate_in(v, conormal[v]); };
+    // Huygens' principle: the front's points move along the characteristics of R(n)|∇φ|, at
+    // V = R n + (dR/dθ) t with t the tangent of the front (n turned by +90° about the normal of S).
+    // V·∇φ = R|∇φ| as for V = R n, so the front moves the same at any instant; but R n turns with
+    // n along a step while this V does not, and a step traced with it no longer runs ahead of the
+    // Wulff shape on the flanks of a head (docs/fire.md, "Huygens' velocity"). dR/dθ by a central
+    // difference over ±1e-3 rad: the same for any R(n), wind and fuel included.
+    auto huygens_at = [&](int v, double rate) {
+      const Vec3& n = conormal[v];
+      if (n.sqrnorm() == 0) return Vec3(0, 0, 0);
+      Vec3 t = OpenMesh::cross(normals[v], n);
+      const double length = t.norm();
+      if (!(length > 0)) return rate * n;
+      t /= length;
+      constexpr double turn = 1e-3;
+      const double c = std::cos(turn), s = std::sin(turn);
+      const double slope = (rate_in(v, c * n + s * t) - rate_in(v, c * n - s * t)) / (2 * turn);
+      return rate * n + slope * t;
+    };
     // A sub-step in a narrow band needs R at the band's vertices only, and no metrics or fields.
     if (!active.empty()) {
       if (rates_.size() != mesh.n_vertices()) rates_.assign(mesh.n_vertices(), 0.0);
       for (int v : active) speed[v] = rates_[std::size_t(v)] = rate_at(v);
+      if (huygens_) {
+        VectorField velocity(mesh.n_vertices(), Vec3(0, 0, 0));
+        for (int v : active) velocity[v] = huygens_at(v, speed[v]);
+        return VelocityField::tangential(std::move(velocity));
+      }
       return VelocityField::normal(std::move(speed));
     }
     for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
@@ -287,6 +314,11 @@ class FireModel final : public VelocityModel {
     if (context.is_terrain()) record_perimeter(context);
 
     VelocityField field = VelocityField::normal(speed);
+    if (huygens_) {
+      field.kind = VelocityField::Kind::Tangential;
+      field.vector.resize(mesh.n_vertices());
+      for (auto v : mesh.vertices()) field.vector[v.idx()] = huygens_at(v.idx(), speed[v.idx()]);
+    }
     // Rate of spread on the front: vertices of interface edges.
     double lo = std::numeric_limits<double>::infinity(), hi = 0, sum = 0;
     std::size_t count = 0;
@@ -495,6 +527,7 @@ class FireModel final : public VelocityModel {
   std::string crs_;
   std::filesystem::path fuel_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
+  bool huygens_ = true;  ///< front_velocity: V = R n + (dR/dθ) t (true) or R n (the paper's)
   ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
   std::string arrival_format_ = config::have_gdal ? "tif" : "asc";
   std::string perimeter_file_ = config::have_gdal ? "perimeters.gpkg" : "";
