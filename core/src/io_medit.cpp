@@ -166,8 +166,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
       }
       in.set_context(nullptr, 0, 0);
     } else {
-      // Unknown keyword: skip its numbers up to the next keyword.
-      while (in.skip_blank() && !in.next_is_word()) in.word();
+      in.skip_numbers();  // an unknown keyword
     }
     in.set_context(nullptr, 0, 0);
   }

@@ -80,7 +80,7 @@ SolRead read_sol_text(std::string_view text, const fs::path& file) {
     } else if (word == "End") {
       break;
     } else {
-      while (in.skip_blank() && !in.next_is_word()) in.word();
+      in.skip_numbers();
     }
   }
   if (!versioned) throw file_error(file, 1, "missing MeshVersionFormatted: not a Medit solution file");

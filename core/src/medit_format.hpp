@@ -120,6 +120,11 @@ class TextScanner {
     return word();
   }
 
+  /// Skip the numbers of a section we do not read, up to the next keyword.
+  void skip_numbers() {
+    while (skip_blank() && !next_is_word()) word();
+  }
+
   /// The number after MeshVersionFormatted: 1 to 4.
   int format_version() {
     const std::int64_t version = integer("the version number");
