@@ -178,7 +178,7 @@ TEST_CASE("sphere cap: topology, regions, quality, surface and interface accurac
 
 TEST_CASE("hausd_interface bounds the interface alone: its edges shorten to the chord of that sag, the rest keeps hmax") {
   // The cap's circle (β = π/4 on the unit sphere) has curvature 1/sin β = √2. At the default hausd
-  // (D/1000 = 3.5e-3) its chords of h ≈ 0.054 sag by h²κ/8 = 5e-4: hmax suffices. With
+  // (D/1000 = 3.5e-3) its chords of h ≈ 0.075 sag by h²κ/8 = 1e-3: hmax suffices. With
   // hausd_interface = 2e-5 the interface's target size is √(8·2e-5/√2) = 0.0106, and its edges may
   // reach √2 times that before a split.
   auto remeshed = [](double hausd_interface, double& h) {
