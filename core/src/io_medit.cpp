@@ -170,7 +170,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
     }
     in.set_context(nullptr, 0, 0);
   }
-  if (header.version == 0) throw file_error(file, 1, "missing MeshVersionFormatted: not a Medit mesh file");
+  require_version(header.version != 0, file, "mesh");
   return r;
 }
 
@@ -198,8 +198,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   walk_binary_keywords(in, format, [&](int code, std::size_t start) {
     switch (code) {
       case kDimension:
-        dimension = in.get<std::int32_t>("the dimension");
-        check_dimension(dimension, [&](const std::string& w) { return in.error(start, w); });
+        dimension = read_binary_dimension(in, start);
         break;
       case kVertices: {
         const std::size_t size = std::size_t(dimension) * format.real_size() + format.int_size();

@@ -83,7 +83,7 @@ SolRead read_sol_text(std::string_view text, const fs::path& file) {
       in.skip_numbers();
     }
   }
-  if (!versioned) throw file_error(file, 1, "missing MeshVersionFormatted: not a Medit solution file");
+  require_version(versioned, file, "solution");
   return result;
 }
 
@@ -94,8 +94,7 @@ SolRead read_sol_binary(std::string_view bytes, const fs::path& file) {
   int dimension = 3;
   walk_binary_keywords(in, format, [&](int code, std::size_t start) {
     if (code == kDimension) {
-      dimension = in.get<std::int32_t>("the dimension");
-      check_dimension(dimension, [&](const std::string& w) { return in.error(start, w); });
+      dimension = read_binary_dimension(in, start);
     } else if (code == kSolAtVertices && !result.found) {
       result.found = true;
       result.offset = start;

@@ -32,6 +32,16 @@ void check_dimension(int dimension, const std::function<InputError(const std::st
   if (dimension != 2 && dimension != 3) throw error(fmt::format("unsupported Dimension {} (expected 2 or 3)", dimension));
 }
 
+int read_binary_dimension(BinaryScanner& in, std::size_t start) {
+  const int dimension = in.get<std::int32_t>("the dimension");
+  check_dimension(dimension, [&](const std::string& w) { return in.error(start, w); });
+  return dimension;
+}
+
+void require_version(bool versioned, const std::filesystem::path& file, const char* what) {
+  if (!versioned) throw file_error(file, 1, fmt::format("missing MeshVersionFormatted: not a Medit {} file", what));
+}
+
 bool plausible_count(std::int64_t count, std::size_t remaining, std::size_t min_bytes) {
   return count >= 0 && std::uint64_t(count) <= remaining / min_bytes + 1;
 }

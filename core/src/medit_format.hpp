@@ -297,6 +297,10 @@ void walk_binary_keywords(BinaryScanner& in, const BinaryFormat& format, Visit&&
 std::int64_t read_count(BinaryScanner& in, const BinaryFormat& format, const char* section);
 /// A Medit Dimension must be 2 or 3.
 void check_dimension(int dimension, const std::function<InputError(const std::string&)>& error);
+/// The value of a binary Dimension keyword that starts at `start`, checked.
+int read_binary_dimension(BinaryScanner& in, std::size_t start);
+/// Throws unless the file had its MeshVersionFormatted line (`what`: "mesh", "solution").
+void require_version(bool versioned, const std::filesystem::path& file, const char* what);
 /// Room for `count` records of at least `min_bytes` each, to reject absurd counts before allocating.
 bool plausible_count(std::int64_t count, std::size_t remaining, std::size_t min_bytes);
 
