@@ -2,12 +2,13 @@
 // and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/performance.md).
 //
 //   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--set key=value]...
-//                       [--iterations N] [--reference-factor 4] [--floor-perturbation 0.01]
-//                       [--fronts DIR] [-o out.csv]
+//                       [--iterations N] [--reference-factor 4] [--reference-hmax 1]
+//                       [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]
 //
 // Runs the case from the same T^0 as "band" (the case as shipped: its max_cfl, sub-steps in a narrow
 // band), "whole" (the same sub-steps on the whole surface), "reference" (max_cfl divided by the
-// factor, whole surface) and "floor" (the band run with hmax × (1 + --floor-perturbation): the same
+// factor, whole surface; --reference-hmax F < 1 also refines its meshes to F × hmax from T^1 on, on the
+// same surface T^0: a reference converged in space as well as in time) and "floor" (the band run with hmax × (1 + --floor-perturbation): the same
 // problem and sub-steps on other meshes from the first remesh on). After every step it records the
 // time per iteration, the sub-steps, the components of G and its area, and the gap between its front
 // and the reference's at the same time (the distances from every end and midpoint of either front's
@@ -140,19 +141,23 @@ int main(int argc, char** argv) try {
   double h = 0;
   int iterations = -1;
   double factor = 4;
+  double reference_hmax = 1;
   double perturbation = 1e-2;
   std::filesystem::path fronts_dir;
   std::filesystem::path csv_path = "bench_fire_accuracy.csv";
   std::vector<std::string> overrides;
   bench::Arguments args("bench_fire_accuracy",
                         "usage: bench_fire_accuracy [--case file.toml] [--h H] [--set key=value]... [--iterations N] "
-                        "[--reference-factor 4] [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]\n"
+                        "[--reference-factor 4] [--reference-hmax 1] [--floor-perturbation 0.01] [--fronts DIR] "
+                        "[-o out.csv]\n"
                         "  --case              fire case with max_cfl > 0 (default meshes/cases/fire_four_disks.toml)\n"
                         "  --h                 surface.h and remesh.hmax in metres (default: the case's)\n"
                         "  --set               a case key for every run, as `bodyfit run --set` (repeatable), e.g.\n"
                         "                      --set surface.max_height=750\n"
                         "  --iterations        steps to run (default: the case's final time)\n"
                         "  --reference-factor  the reference divides max_cfl by this (default 4)\n"
+                        "  --reference-hmax    the reference's meshes after T^0 at this × hmax, on the same surface\n"
+                        "                      (default 1; 0.5: a reference refined in space too)\n"
                         "  --floor-perturbation  the floor run (the band run on other meshes) multiplies hmax by\n"
                         "                      1 + this after T^0 (default 0.01; 0: no floor run)\n"
                         "  --fronts            directory: every run's front at every step, <run>_<step>.txt\n"
@@ -162,11 +167,13 @@ int main(int argc, char** argv) try {
   args.option("--set", [&](const std::string& value) { overrides.push_back(value); });
   args.option("--iterations", iterations);
   args.option("--reference-factor", factor);
+  args.option("--reference-hmax", reference_hmax);
   args.option("--floor-perturbation", perturbation);
   args.option("--fronts", fronts_dir);
   args.option("-o", csv_path);
   args.parse(argc, argv);
   if (!(factor >= 1)) args.fail("--reference-factor must be at least 1");
+  if (!(reference_hmax > 0 && reference_hmax <= 1)) args.fail("--reference-hmax must be in (0, 1]");
   if (!(perturbation >= 0 && perturbation < 0.5)) args.fail("--floor-perturbation must be in [0, 0.5)");
   if (!fronts_dir.empty() && !std::filesystem::is_directory(fronts_dir))
     args.fail("--fronts: no directory " + fronts_dir.string());
@@ -180,7 +187,7 @@ int main(int argc, char** argv) try {
   const double max_cfl = config.time.max_cfl;
   if (!(max_cfl > 0)) args.fail("the case has no max_cfl: nothing to compare");
   std::vector<Run> runs;
-  runs.push_back(run("reference", config, max_cfl / factor, false, iterations));
+  runs.push_back(run("reference", config, max_cfl / factor, false, iterations, reference_hmax));
   runs.push_back(run("band", config, max_cfl, true, iterations));
   runs.push_back(run("whole", config, max_cfl, false, iterations));
   if (perturbation > 0) runs.push_back(run("floor", config, max_cfl, true, iterations, 1 + perturbation));
@@ -192,8 +199,8 @@ int main(int argc, char** argv) try {
   std::ofstream csv(csv_path);
   csv << "run,iteration,time,faces,substeps,components,area,ms_total,gap_mean_h,gap_median_h,gap_p95_h,gap_max_h,"
          "offset_h,band_gap_max_h,band_gap_mean_h\n";
-  fmt::print("{}: h = {} m, max_cfl {} (reference {}), {} steps\n", case_file.string(), length, max_cfl,
-             max_cfl / factor, reference.steps.size());
+  fmt::print("{}: h = {} m, max_cfl {} (reference {} at {} × hmax), {} steps\n", case_file.string(), length,
+             max_cfl, max_cfl / factor, reference_hmax, reference.steps.size());
   fmt::print("{:>10} {:>8} {:>8} {:>9} {:>6} {:>5} | to reference / h, worst step: {:>6} {:>6} {:>6}, last: {:>6} "
              "{:>7} | to band, worst: {:>6} {:>6}\n",
              "run", "wall s", "ms/step", "sub-steps", "merge", "comp", "mean", "p95", "max", "median", "offset", "mean",
