@@ -176,6 +176,15 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
     double len = n.norm();
     normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
   }
+  vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
+  for (const auto& t : tri_) {
+    const Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);  // 2·area weighting
+    for (int i : t) vertex_normal_[std::size_t(i)] += n;
+  }
+  for (Vec3& n : vertex_normal_) {
+    const double len = n.norm();
+    if (len > 0) n /= len;
+  }
 }
 
 
@@ -236,6 +245,15 @@ SurfacePoint ReferenceSurface::closest(const Vec3& p, int hint) const {
   detail::nearest(*tree_, p, best2, consider);
   out.normal = normal_[out.face];
   return out;
+}
+
+Vec3 ReferenceSurface::smooth_normal(const SurfacePoint& q) const {
+  if (q.face < 0) return q.normal;
+  const auto& t = tri_[std::size_t(q.face)];
+  const auto w = barycentric(q.point, points_[t[0]], points_[t[1]], points_[t[2]]);
+  const Vec3 n = w[0] * vertex_normal_[t[0]] + w[1] * vertex_normal_[t[1]] + w[2] * vertex_normal_[t[2]];
+  const double len = n.norm();
+  return len > 0 ? n / len : q.normal;
 }
 
 ReferencePolyline::ReferencePolyline() = default;

@@ -32,6 +32,12 @@ class ReferenceSurface {
 
   /// Closest point of S to p. `hint` (a reference triangle near p, or -1) speeds up the search.
   SurfacePoint closest(const Vec3& p, int hint = -1) const;
+  /// S's smooth unit normal at its closest point to p: S's vertex normals (area-weighted, as
+  /// vertex_normal()) interpolated barycentrically there. A continuous field and one function of
+  /// position, whatever mesh samples it; at a vertex of S it is S's vertex normal (a sphere: exact).
+  Vec3 smooth_normal(const Vec3& p, int hint = -1) const { return smooth_normal(closest(p, hint)); }
+  /// The same at a point closest() returned.
+  Vec3 smooth_normal(const SurfacePoint& q) const;
   bool analytic() const { return is_sphere_; }
   /// Radius of the analytic sphere (0 for a triangle reference).
   double sphere_radius() const { return is_sphere_ ? radius_ : 0.0; }
@@ -46,6 +52,7 @@ class ReferenceSurface {
   std::vector<Vec3> points_;
   std::vector<std::array<int, 3>> tri_;
   std::vector<Vec3> normal_;
+  std::vector<Vec3> vertex_normal_;
   mutable std::once_flag tree_once_;
   mutable std::unique_ptr<detail::BoxTree> tree_;
 };
