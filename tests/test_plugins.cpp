@@ -4,6 +4,7 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/plugin_loader.hpp>
+#include <bodyfit/projection.hpp>
 
 #include "test_support.hpp"
 
@@ -162,10 +163,10 @@ TEST_CASE("bodyfit plugins lists names, versions, ABI, files, parameters and fai
   auto result = test::run_bodyfit("plugins");
   CAPTURE(result.output);
   CHECK(result.exit_code == 0);
-  CHECK(contains(result.output, "conormal 1.0  (ABI 2.4)"));
+  CHECK(contains(result.output, "conormal 1.0  (ABI 2.5)"));
   CHECK(contains(result.output, "bodyfit_conormal.so"));
   CHECK(contains(result.output, "speed = 1"));
-  CHECK(contains(result.output, "testgood 2.5  (ABI 2.4)"));
+  CHECK(contains(result.output, "testgood 2.5  (ABI 2.5)"));
   CHECK(contains(result.output, "value = 0.5"));
   CHECK(contains(result.output, "constant normal speed (test)"));
   CHECK(contains(result.output, "2 files failed to load"));
@@ -283,4 +284,28 @@ TEST_CASE("edit distance and closest match") {
   CHECK(edit_distance("same", "same") == 0);
   CHECK(closest_match("sped", {"speed", "length"}) == "speed");
   CHECK(closest_match("qqqqqq", {"speed", "length"}).empty());
+}
+
+TEST_CASE("StepContext::surface_normals: S's smooth normal at the vertices, the vertex normals without S or on S") {
+  const SurfaceMesh coarse = make_sphere({.faces = 320});
+  const ReferenceSurface surface(coarse);
+  const SurfaceMesh fine = make_sphere({.faces = 1280});  // its vertices on the exact sphere, not on S
+  const ScalarField d_fine(fine.n_vertices(), 0.0), d_coarse(coarse.n_vertices(), 0.0);
+  StandaloneStep where;
+  where.surface = &surface;
+  const StepContext on_fine = StepContext::standalone(fine, d_fine, where);
+  const VectorField& normals = on_fine.surface_normals();
+  REQUIRE(normals.size() == fine.n_vertices());
+  double farthest = 0;
+  for (auto v : fine.vertices()) {
+    CHECK((normals[v.idx()] - surface.smooth_normal(fine.point(v))).norm() < 1e-12);
+    farthest = std::max(farthest, (normals[v.idx()] - on_fine.vertex_normals()[v.idx()]).norm());
+  }
+  CHECK(farthest > 1e-3);  // S's field, not the fine mesh's own normals
+  // On S itself: S's vertex normals. Without S: the mesh's.
+  const StepContext on_coarse = StepContext::standalone(coarse, d_coarse, where);
+  for (auto v : coarse.vertices())
+    CHECK((on_coarse.surface_normals()[v.idx()] - on_coarse.vertex_normals()[v.idx()]).norm() < 1e-12);
+  const StepContext without = StepContext::standalone(fine, d_fine);
+  CHECK(without.surface_normals() == without.vertex_normals());
 }

@@ -496,7 +496,8 @@ class Evolution {
                                        .terrain = options_.terrain,
                                        .clock_start = options_.clock_start,
                                        .active = active,
-                                       .geometry = geometry});
+                                       .geometry = geometry,
+                                       .surface = options_.remesh.reference.get()});
   }
   void stop(StopReason reason, std::string message) {
     stopped_ = true;

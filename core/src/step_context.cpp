@@ -4,6 +4,8 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/surface_fem.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -12,6 +14,28 @@
 
 namespace bodyfit {
 
+namespace {
+
+/// S's smooth normal at every vertex. Fixed blocks, each searching from its previous vertex's
+/// triangle (neighbours in index order are near each other): the same result for any thread count.
+VectorField smooth_normals(const SurfaceMesh& mesh, const ReferenceSurface& surface) {
+  VectorField normals(mesh.n_vertices(), Vec3(0, 0, 0));
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, mesh.n_vertices(), 512),
+      [&](const tbb::blocked_range<std::size_t>& block) {
+        int hint = -1;
+        for (std::size_t v = block.begin(); v < block.end(); ++v) {
+          const SurfacePoint q = surface.closest(mesh.point(VertexHandle(int(v))), hint);
+          hint = q.face;
+          normals[v] = surface.smooth_normal(q);
+        }
+      },
+      tbb::simple_partitioner());
+  return normals;
+}
+
+}  // namespace
+
 struct StepContext::Impl {
   StepState state;
   // Caches: filled on first use under the mutex; never modified afterwards, so the references
@@ -19,7 +43,7 @@ struct StepContext::Impl {
   mutable std::mutex mutex;
   mutable std::optional<double> mesh_size;
   mutable std::optional<std::vector<double>> face_areas;
-  mutable std::optional<VectorField> face_normals, vertex_normals, conormal;
+  mutable std::optional<VectorField> face_normals, vertex_normals, surface_normals, conormal;
   mutable std::optional<Eigen::SparseMatrix<double>> mass, stiffness;
   mutable std::map<double, H1Smoother> smoothers;  // one factorisation per length
 
@@ -37,6 +61,16 @@ struct StepContext::Impl {
     if (!state.geometry) return compute(vertex_normals);
     std::lock_guard lock(state.geometry->mutex);  // the step's contexts share one copy
     return compute(state.geometry->vertex_normals);
+  }
+  const VectorField& surface_normals_locked() const {
+    if (!state.surface) return vertex_normals_locked();
+    auto compute = [&](std::optional<VectorField>& cache) -> const VectorField& {
+      if (!cache) cache = smooth_normals(mesh(), *state.surface);
+      return *cache;
+    };
+    if (!state.geometry) return compute(surface_normals);
+    std::lock_guard lock(state.geometry->mutex);
+    return compute(state.geometry->surface_normals);
   }
   const Eigen::SparseMatrix<double>& mass_locked() const {
     if (!mass) mass = bodyfit::mass_matrix(mesh());
@@ -78,7 +112,8 @@ StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& 
                                      .terrain = where.terrain,
                                      .clock_start = where.clock_start,
                                      .active = {},
-                                     .geometry = nullptr});
+                                     .geometry = nullptr,
+                                     .surface = where.surface});
 }
 
 const SurfaceMesh& StepContext::mesh() const { return *impl_->state.mesh; }
@@ -120,6 +155,11 @@ const VectorField& StepContext::face_normals() const {
 const VectorField& StepContext::vertex_normals() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->vertex_normals_locked();
+}
+
+const VectorField& StepContext::surface_normals() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->surface_normals_locked();
 }
 
 const VectorField& StepContext::conormal() const {

@@ -1,5 +1,6 @@
 #pragma once
 // The driver's side of StepContext: what a context is built from (private to the core).
+#include <bodyfit/projection.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <filesystem>
@@ -13,6 +14,7 @@ namespace bodyfit {
 struct StepGeometry {
   std::mutex mutex;
   std::optional<VectorField> vertex_normals;
+  std::optional<VectorField> surface_normals;
 };
 
 struct StepState {
@@ -25,6 +27,7 @@ struct StepState {
   std::optional<double> clock_start;      ///< seconds since the epoch at t = 0 ([time] start)
   std::span<const int> active;            ///< narrow band: where V is needed (empty: every vertex)
   StepGeometry* geometry = nullptr;       ///< shared with the other contexts of the step (optional)
+  const ReferenceSurface* surface = nullptr;  ///< the fixed input surface S (optional)
 };
 
 /// The context for one (sub-)step or candidate; `state`'s pointers must outlive it.

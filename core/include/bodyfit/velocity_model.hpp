@@ -34,7 +34,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 4;
+inline constexpr std::uint32_t kPluginAbiMinor = 5;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// One parameter a model accepts, for `bodyfit plugins` and for error messages.
@@ -82,6 +82,8 @@ struct SurfaceSource {
   std::string reprojected_from{};
 };
 
+class ReferenceSurface;  // projection.hpp
+
 /// Where and when a StepContext made outside a run stands (StepContext::standalone).
 struct StandaloneStep {
   double time = 0, dt = 0;
@@ -89,6 +91,7 @@ struct StandaloneStep {
   std::filesystem::path output_dir;
   bool terrain = false;
   std::optional<double> clock_start;  ///< StepContext::clock_start
+  const ReferenceSurface* surface = nullptr;  ///< S for StepContext::surface_normals (must outlive it)
 };
 
 /// Read-only view of the state at iteration n, with the helpers a model needs. Geometric helpers
@@ -130,6 +133,12 @@ class StepContext {
   const std::vector<double>& face_areas() const;
   const VectorField& face_normals() const;
   const VectorField& vertex_normals() const;
+  /// (ABI 2.5) The unit normal of the fixed input surface S at the vertices: S's vertex normals
+  /// interpolated at each vertex's closest point of S (ReferenceSurface::smooth_normal). One
+  /// function of position whatever T^n is, where vertex_normals() change with every remesh: what a
+  /// model whose V depends on S's orientation (a slope) should read. vertex_normals() when the
+  /// driver has no reference surface.
+  const VectorField& surface_normals() const;
   /// Unit conormal n_Σ = ∇_S d / |∇_S d| at the vertices, extended to the whole surface.
   const VectorField& conormal() const;
   /// Per-face and per-vertex tangential gradients of a P1 field.
