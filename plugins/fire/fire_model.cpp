@@ -114,6 +114,9 @@ class FireModel final : public VelocityModel {
         {"front_velocity", "\"huygens\"", "huygens: V = R n_Σ + (dR/dθ) t, along the front's characteristics "
                                           "(Huygens' principle); normal: V = R n_Σ as in the paper. The same front "
                                           "as the steps shrink; huygens is closer at a given step"},
+        {"slope", "\"surface\"", "surface: the slope from the input surface's smooth normal, one field whatever the "
+                                   "mesh; mesh: from the current mesh's vertex normals, which change with every "
+                                   "remesh"},
         {"wind.type", "\"none\"", "none | uniform | rotating | grid | series | grid_series"},
         {"wind.velocity", "[0, 0]", "uniform wind (x, y), m/s"},
         {"wind.speed, wind.direction_deg", "", "uniform wind as speed (m/s) and the direction it blows from (degrees "
@@ -154,6 +157,7 @@ class FireModel final : public VelocityModel {
     base_.v0 = p.number("v0", 12 * base_.R0, {.min = 0, .min_exclusive = true});
     base_.max_tilt = p.number("max_tilt_deg", 80, {.min = 0, .max = 90, .min_exclusive = true, .max_exclusive = true}) * kDegree;
     huygens_ = p.choice("front_velocity", "huygens", {"huygens", "normal"}) == "huygens";
+    surface_slope_ = p.choice("slope", "surface", {"surface", "mesh"}) == "surface";
 
     if (const toml::table* wind = p.table("wind"))
       wind_ = read_wind_table(*wind, [&](const std::filesystem::path& file) {
@@ -247,7 +251,10 @@ class FireModel final : public VelocityModel {
   VelocityField compute(const StepContext& context) override {
     const SurfaceMesh& mesh = context.mesh();
     const VectorField& conormal = context.conormal();
-    const VectorField& normals = context.vertex_normals();
+    // The terrain's orientation: S's own smooth normal, the same at a point whatever mesh samples it.
+    // The remeshed T^n's vertex normals average other faces at every step, and the front picked up
+    // that noise in R (docs/fire.md, "Slope from the surface").
+    const VectorField& normals = surface_slope_ ? context.surface_normals() : context.vertex_normals();
     if (!wind_.has_center) {
       BoundingBox box = bounding_box(mesh);
       wind_.center = 0.5 * (box.min + box.max);
@@ -278,7 +285,15 @@ class FireModel final : public VelocityModel {
       double tan_gamma = tan_tilt(slope_term, std::abs(normal[2]), wind_term, *fuel);
       return rate_of_spread(std::atan(tan_gamma), *fuel);
     };
-    auto rate_at = [&](int v) { return rate_in(v, conormal[v]); };
+    // n_Σ in the tangent plane of the normal the slope is read from (∇_S s · n_Σ = e3 · n_Σ holds there).
+    auto front_normal = [&](int v) {
+      const Vec3& n = conormal[v];
+      if (!surface_slope_ || n.sqrnorm() == 0) return n;
+      const Vec3 tangent = n - OpenMesh::dot(n, normals[v]) * normals[v];
+      const double length = tangent.norm();
+      return length > 1e-12 ? tangent / length : n;
+    };
+    auto rate_at = [&](int v) { return rate_in(v, front_normal(v)); };
     // Huygens' principle: the front's points move along the characteristics of R(n)|∇φ|, at
     // V = R n + (dR/dθ) t with t the tangent of the front (n turned by +90° about the normal of S).
     // V·∇φ = R|∇φ| as for V = R n, so the front moves the same at any instant; but R n turns with
@@ -286,7 +301,7 @@ class FireModel final : public VelocityModel {
     // Wulff shape on the flanks of a head (docs/fire.md, "Huygens' velocity"). dR/dθ by a central
     // difference over ±1e-3 rad: the same for any R(n), wind and fuel included.
     auto huygens_at = [&](int v, double rate) {
-      const Vec3& n = conormal[v];
+      const Vec3 n = front_normal(v);
       if (n.sqrnorm() == 0) return Vec3(0, 0, 0);
       Vec3 t = OpenMesh::cross(normals[v], n);
       const double length = t.norm();
@@ -528,6 +543,7 @@ class FireModel final : public VelocityModel {
   std::filesystem::path fuel_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
   bool huygens_ = true;  ///< front_velocity: V = R n + (dR/dθ) t (true) or R n (the paper's)
+  bool surface_slope_ = true;  ///< slope: from S's smooth normal (true) or T^n's vertex normals
   ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
   std::string arrival_format_ = config::have_gdal ? "tif" : "asc";
   std::string perimeter_file_ = config::have_gdal ? "perimeters.gpkg" : "";
