@@ -79,6 +79,8 @@ TEST_CASE("a valid case is read into its options") {
   CHECK(c.remesh.hmax == 0.2);
   CHECK(c.remesh.hausd_interface == 0);  // the interface's tolerance is hausd unless given
   CHECK(parse(kValidCase, {"remesh.hausd_interface=0.001"}).remesh.hausd_interface == 0.001);
+  CHECK_FALSE(c.discretize.drop_detached);  // new parts are kept unless asked
+  CHECK(parse(kValidCase, {"discretize.drop_detached=true"}).discretize.drop_detached);
   CHECK(c.output.vtu_every == 1);
 }
 
@@ -140,6 +142,8 @@ TEST_CASE("wrong types and values are errors naming the key") {
   CHECK_MESSAGE(contains(e, "[remesh] hmax: -1 is out of range (0, inf)"), e);
   e = error_of(kValidCase, {"remesh.hausd_interface=0"});
   CHECK_MESSAGE(contains(e, "[remesh] hausd_interface: 0 is out of range (0, inf)"), e);
+  e = error_of(kValidCase, {"discretize.drop_detached=1"});
+  CHECK_MESSAGE(contains(e, "[discretize] drop_detached: expected"), e);
   e = error_of(kValidCase, {"region.axis=[1, 2]"});
   CHECK_MESSAGE(contains(e, "[region] axis: expected 3 numbers, got 2"), e);
   e = error_of(kValidCase, {"surface.extent=5"});

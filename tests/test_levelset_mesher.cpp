@@ -684,6 +684,45 @@ TEST_CASE("vertices the remesher cannot move snap with fixed_snap_ratio, free ve
   }
 }
 
+TEST_CASE("grown_from: a new part that does not meet the old region goes to the outside, whatever its size") {
+  // The old region: a disk. The new one: the disk grown, a blob 4 h across ahead of it that does
+  // not meet the old disk, and a larger blob that overlaps it. With grown_from (the old disk's
+  // distance) the far blob is given to the outside; the rest stays as without.
+  const int n = 48;
+  const double h = 1.0 / n;
+  const Vec3 centre(0.3, 0.5, 0), far(0.8, 0.5, 0), overlap(0.3, 0.72, 0);
+  auto old_distance = [&](const Vec3& p) { return (p - centre).norm() - 0.15; };
+  auto grown = [&](const Vec3& p) {
+    return std::min({(p - centre).norm() - 0.2, (p - far).norm() - 2 * h, (p - overlap).norm() - 0.1});
+  };
+  SurfaceMesh kept = make_square(n);
+  const DiscretizeReport kept_report = discretize(kept, sample(kept, grown));
+  CHECK(kept_report.removed_detached == 0);
+  CHECK(region_components(kept, kInside) == 2);
+
+  SurfaceMesh mesh = make_square(n);
+  const ScalarField from = sample(mesh, old_distance);
+  DiscretizeOptions options;
+  options.grown_from = from;
+  const DiscretizeReport report = discretize(mesh, sample(mesh, grown), options);
+  require_valid(mesh, strict(1, 1));
+  CHECK(report.removed_detached == 1);
+  CHECK(region_components(mesh, kInside) == 1);
+  CHECK(region_components(mesh, kOutside) == 1);
+  CHECK(interface_curves(mesh).closed == 1);
+  // What went is the far blob: π (2h)², to the polygon's chords.
+  CHECK(region_area(kept, kInside) - region_area(mesh, kInside) == doctest::Approx(pi * 4 * h * h).epsilon(0.05));
+  for (auto v : mesh.vertices()) {
+    bool inside_face = false, outside_face = false;
+    for (auto f : mesh.vf_range(v)) (mesh.region(f) == kInside ? inside_face : outside_face) = true;
+    if (!outside_face) CHECK(mesh.phi(v) <= 0);
+    if (!inside_face) CHECK(mesh.phi(v) >= 0);
+  }
+  // grown_from must have one value per vertex of the input.
+  SurfaceMesh other = make_square(n / 2);
+  CHECK_THROWS_AS(discretize(other, sample(other, grown), options), InputError);
+}
+
 TEST_CASE("specks: parts of a region below speck_area·h² go to the region around them") {
   const int n = 32;
   const double h = 1.0 / n, r = 0.2;

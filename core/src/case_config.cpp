@@ -247,6 +247,7 @@ void parse_stages(const toml::table& table, CaseConfig& config) {
     out.snap_ratio = p.number("snap_ratio", out.snap_ratio, snap);
     out.fixed_snap_ratio = p.number("fixed_snap_ratio", out.fixed_snap_ratio, snap);
     out.speck_area = p.number("speck_area", out.speck_area, {.min = 0});
+    out.drop_detached = p.boolean("drop_detached", out.drop_detached);
     out.hermite_crossings = p.boolean("hermite_crossings", out.hermite_crossings);
     out.fitted_slopes = p.boolean("fitted_slopes", out.fitted_slopes);
     p.reject_unknown();

@@ -366,7 +366,11 @@ class Evolution {
     candidate_ = true;  // from here on the mesh is no longer T^n
     solver_.reset();  // T^n's, and memory the remesh can use
     Stopwatch clock;
-    discretize(mesh_, step.phi_next, options_.discretize);
+    DiscretizeOptions cut = options_.discretize;
+    if (cut.drop_detached) cut.grown_from = distance_;  // d^n on T^n: G^{n+1} grows from G^n
+    const DiscretizeReport report = discretize(mesh_, step.phi_next, cut);
+    if (report.removed_detached > 0)
+      spdlog::debug("n={}: {} part(s) of G detached from G^n given to the outside", n_ + 1, report.removed_detached);
     step.ms.discretize += clock.lap_ms();
     remesh(mesh_, options_.remesh);
     if (options_.canonical_order) canonicalize(mesh_);

@@ -347,6 +347,64 @@ std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area
   return removed;
 }
 
+/// Give to the outside every part of the inside region with no face that has a corner among the
+/// input's vertices where `grown_from` ≤ 0 (DiscretizeOptions::grown_from). The parts are grown from
+/// `seeds` (faces around the zeros of φ: every inside part that is not a whole component of S has
+/// one); a part's growth stops at its first face that meets the old region, and a part reaching a
+/// face already known to do so stops too. Returns how many parts were given away.
+std::size_t remove_detached(SurfaceMesh& mesh, ScalarField& value, std::span<const double> grown_from,
+                            const std::vector<FaceHandle>& seeds, double tiny) {
+  constexpr int kUnseen = -1, kRooted = -2;
+  auto meets_old_region = [&](FaceHandle f) {
+    for (auto v : mesh.fv_range(f))
+      if (std::size_t(v.idx()) < grown_from.size() && grown_from[std::size_t(v.idx())] <= 0) return true;
+    return false;
+  };
+  std::vector<int> mark(mesh.n_faces(), kUnseen);
+  std::vector<FaceHandle> stack, part;
+  std::vector<std::vector<FaceHandle>> detached;
+  for (auto seed : seeds) {
+    if (mesh.region(seed) != kInside || mark[std::size_t(seed.idx())] != kUnseen) continue;
+    const int id = int(detached.size());
+    bool rooted = false;
+    part.assign(1, seed);
+    stack.assign(1, seed);
+    mark[std::size_t(seed.idx())] = id;
+    while (!stack.empty() && !rooted) {
+      auto f = stack.back();
+      stack.pop_back();
+      rooted = meets_old_region(f);
+      for (auto g : mesh.ff_range(f)) {
+        if (mesh.region(g) != kInside) continue;
+        int& m = mark[std::size_t(g.idx())];
+        if (m == kRooted) rooted = true;
+        if (m != kUnseen) continue;
+        m = id;
+        part.push_back(g);
+        stack.push_back(g);
+      }
+    }
+    if (rooted) {
+      for (auto f : part) mark[std::size_t(f.idx())] = kRooted;
+    } else {
+      detached.push_back(part);
+    }
+  }
+  for (const auto& faces : detached)
+    for (auto f : faces) mesh.region(f) = kOutside;
+  // φ takes the outside's sign where every face around a vertex is now outside (a zero becomes a
+  // hair above zero).
+  for (const auto& faces : detached)
+    for (auto f : faces)
+      for (auto v : mesh.fv_range(f)) {
+        double& x = value[std::size_t(v.idx())];
+        bool all_outside = true;
+        for (auto g : mesh.vf_range(v)) all_outside = all_outside && mesh.region(g) != kInside;
+        if (all_outside && x <= 0) x = std::max(-x, tiny);
+      }
+  return detached.size();
+}
+
 }  // namespace
 
 DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options) {
@@ -355,7 +413,10 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     throw InputError("discretize: the level set has " + std::to_string(phi.size()) + " values for " +
                      std::to_string(mesh.n_vertices()) + " vertices");
   ScalarField value = phi;
-  const double h_input = options.speck_area > 0 ? edge_length_stats(mesh).mean : 0;
+  if (!options.grown_from.empty() && options.grown_from.size() != mesh.n_vertices())
+    throw InputError("discretize: grown_from has " + std::to_string(options.grown_from.size()) + " values for " +
+                     std::to_string(mesh.n_vertices()) + " vertices");
+  const double h_input = options.speck_area > 0 || !options.grown_from.empty() ? edge_length_stats(mesh).mean : 0;
   // Vertices that may end up on the level set: the input's zeros and the ends of crossed edges
   // (snapped); the cut adds its new vertices. The faces around them are the speck search's seeds.
   std::vector<VertexHandle> may_be_zero;
@@ -369,7 +430,8 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   std::vector<EdgeHandle> crossed;
   for (auto e : mesh.edges())
     if (crossed_edge(mesh, value, e)) crossed.push_back(e);
-  if (options.speck_area > 0)
+  const bool find_parts = options.speck_area > 0 || !options.grown_from.empty();
+  if (find_parts)
     for (auto e : crossed)
       for (int side = 0; side < 2; ++side) may_be_zero.push_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)));
   snap(mesh, crossed, value, options, report);
@@ -472,7 +534,7 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
                   value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
   }
-  if (options.speck_area > 0) {
+  if (find_parts) {
     std::vector<FaceHandle> seeds;
     auto seed_around = [&](VertexHandle v) {
       if (value[v.idx()] == 0)
@@ -480,7 +542,9 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     };
     for (auto v : may_be_zero) seed_around(v);
     for (int v = first_crossing; v < int(mesh.n_vertices()); ++v) seed_around(VertexHandle(v));
-    report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
+    if (!options.grown_from.empty()) report.removed_detached = remove_detached(mesh, value, options.grown_from, seeds, 1e-12 * h_input);
+    if (options.speck_area > 0)
+      report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
   }
   for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
   for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];

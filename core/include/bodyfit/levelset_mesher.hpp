@@ -6,6 +6,8 @@
 // docs/levelset_mesher.md describes the cutting patterns, the snapping rule and the degenerate cases.
 #include <bodyfit/mesh.hpp>
 
+#include <span>
+
 namespace bodyfit {
 
 struct DiscretizeOptions {
@@ -48,6 +50,16 @@ struct DiscretizeOptions {
   /// stops at this area, so it costs in proportion to the interface; a whole component of S lying
   /// in one region has no interface and is never a speck.
   double speck_area = 0.1;
+  /// Parts cut off the old region. With `grown_from` (the signed distance d^n to the region the
+  /// new one grows from, at the input's vertices; empty: off), a part of the inside region none of
+  /// whose faces has a corner where d^n ≤ 0 does not meet the old region, and is given to the
+  /// outside whatever its size. A front that only grows from itself (a fire without spotting)
+  /// cannot leave such a part: it is the tip of a tongue cut off its neck between two vertices.
+  /// The search grows the inside parts from the interface and stops at the first face that meets
+  /// the old region, so it costs in proportion to the region gained.
+  std::span<const double> grown_from{};
+  /// In an evolution: fill `grown_from` with d^n at every step's cut (`[discretize] drop_detached`).
+  bool drop_detached = false;
 };
 
 struct DiscretizeReport {
@@ -59,6 +71,7 @@ struct DiscretizeReport {
   std::size_t flipped_diagonals = 0;  ///< quads (2-crossing pattern) where the other diagonal was better
   std::size_t interface_edges = 0;    ///< edges tagged e:interface on return
   std::size_t inside_faces = 0;       ///< faces labelled kInside on return
+  std::size_t removed_detached = 0;   ///< inside parts that did not meet the old region (grown_from)
   /// Vertices where the input φ is exactly 0 but the inside region would touch itself (a saddle
   /// of φ at the vertex, or inside parts meeting at a boundary vertex): they are put on the
   /// outside (φ set to a small positive value) and the cut passes next to them.
