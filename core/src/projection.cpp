@@ -167,26 +167,22 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
     index[v.idx()] = int(points_.size());
     points_.push_back(mesh.point(v));
   }
+  vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
   for (auto f : mesh.faces()) {
     std::array<int, 3> t{};
     int k = 0;
     for (auto v : mesh.fv_range(f)) t[k++] = index[v.idx()];
     tri_.push_back(t);
-    Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);
-    double len = n.norm();
+    const Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);
+    const double len = n.norm();
     normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
-  }
-  vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
-  for (const auto& t : tri_) {
-    const Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);  // 2·area weighting
-    for (int i : t) vertex_normal_[std::size_t(i)] += n;
+    for (int i : t) vertex_normal_[std::size_t(i)] += n;  // weighted by twice the area
   }
   for (Vec3& n : vertex_normal_) {
     const double len = n.norm();
     if (len > 0) n /= len;
   }
 }
-
 
 ReferenceSurface::~ReferenceSurface() = default;
 
