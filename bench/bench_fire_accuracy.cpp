@@ -3,22 +3,29 @@
 //
 //   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--set key=value]...
 //                       [--iterations N] [--reference-factor 4] [--reference-hmax 1]
-//                       [--floor-perturbation 0.01] [--fronts DIR] [-o out.csv]
+//                       [--floor-perturbation 0.01] [--reference-floor] [--fronts DIR] [-o out.csv]
 //
 // Runs the case from the same T^0 as "band" (the case as shipped: its max_cfl, sub-steps in a narrow
 // band), "whole" (the same sub-steps on the whole surface), "reference" (max_cfl divided by the
-// factor, whole surface; --reference-hmax F < 1 also refines its meshes to F × hmax from T^1 on, on the
-// same surface T^0: a reference converged in space as well as in time) and "floor" (the band run with hmax × (1 + --floor-perturbation): the same
-// problem and sub-steps on other meshes from the first remesh on). After every step it records the
-// time per iteration, the sub-steps, the components of G and its area, and the gap between its front
-// and the reference's at the same time (the distances from every end and midpoint of either front's
-// edges to the other: mean, median, 95th percentile, max) and the signed offset (the difference of
-// the burnt areas over the fronts' mean length: > 0 ahead of the reference), all in units of the
-// case's h. The floor run's gap to the band run is how far two meshes alone take the same
-// computation apart: the yardstick for the gap to the reference. Prints a summary (the worst step of
-// each, the last step's median and offset, the step where G becomes one component, the most
-// components) and writes one CSV row per run and step, with the gap to the band run too
-// (band_gap_max_h, band_gap_mean_h). --fronts DIR writes every run's front at every step as
+// factor, whole surface; --reference-hmax F < 1 also refines its meshes to F × hmax from T^1 on, on
+// the same surface T^0: a reference converged in space as well as in time) and "floor" (the band run
+// with hmax × (1 + --floor-perturbation): the same problem and sub-steps on other meshes from the
+// first remesh on). --reference-floor adds "reference_floor", the reference on the floor's meshes:
+// how far the reference itself moves when only its meshes change.
+//
+// After every step it records the time per iteration, the sub-steps, the components of G and its
+// area, and the gap between its front and the reference's at the same time (the distances from every
+// end and midpoint of either front's edges to the other: mean, median, 95th percentile, max) and the
+// signed offset (the difference of the burnt areas over the fronts' mean length: > 0 ahead of the
+// reference), all in units of the case's h. A closed curve of either front that keeps more than h
+// from the other is "unmatched": a pocket one run has burnt out a step before the other, an island;
+// the mean over the other curves is the matched gap. The floor run's gap to the band run is how far
+// two meshes alone take the same computation apart: the yardstick for the gap to the reference.
+//
+// Prints a summary (the worst step of each, the last step's median and offset, the step where G
+// becomes one component, the most components; then every step whose mean gap passes h/4, with its
+// matched gap and unmatched curves) and writes one CSV row per run and step, with the gap to the band
+// run too (band_gap_max_h, band_gap_mean_h). --fronts DIR writes every run's front at every step as
 // DIR/<run>_<step>.txt, one segment "x0 y0 z0 x1 y1 z1" per line.
 #include "bench_args.hpp"
 
@@ -31,11 +38,13 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <string>
 #include <vector>
 
@@ -44,8 +53,14 @@ using namespace bodyfit;
 namespace {
 
 /// Distances between two fronts: from every end and midpoint of a segment of either to the other.
+/// A closed curve of either front that keeps more than `apart` from the other (a pocket that one run
+/// has burnt out and the other not yet, an island) is counted as unmatched; `matched_mean` is the
+/// mean over the other curves.
 struct FrontGap {
   double mean = 0, median = 0, p95 = 0, max = 0;
+  double matched_mean = 0;
+  int unmatched = 0;
+  double unmatched_length = 0;
 };
 
 double front_length(const Segments& front) {
@@ -65,14 +80,56 @@ double to_segments(const Vec3& p, const Segments& to) {
   return nearest;
 }
 
-FrontGap front_gap(const Segments& a, const Segments& b) {
+/// The curve of every segment: segments that share an end are on one curve (the front's edges are
+/// mesh edges, so shared ends are equal points).
+std::vector<int> front_curves(const Segments& front) {
+  std::vector<int> parent(front.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::map<std::array<double, 3>, int> first_at;
+  for (int i = 0; i < int(front.size()); ++i)
+    for (const Vec3& p : {front[i].first, front[i].second}) {
+      const auto [it, inserted] = first_at.try_emplace({p[0], p[1], p[2]}, i);
+      if (!inserted) parent[root(i)] = root(it->second);
+    }
+  std::vector<int> curve(front.size());
+  for (int i = 0; i < int(front.size()); ++i) curve[i] = root(i);
+  return curve;
+}
+
+FrontGap front_gap(const Segments& a, const Segments& b, double apart) {
   std::vector<double> d;
-  for (const auto* pair : {&a, &b})
-    for (const auto& [p, q] : *pair)
-      for (const Vec3& x : {p, q, 0.5 * (p + q)}) d.push_back(to_segments(x, pair == &a ? b : a));
-  if (d.empty()) return {};
-  std::sort(d.begin(), d.end());
+  std::vector<char> matched;
   FrontGap g;
+  for (const auto* pair : {&a, &b}) {
+    const Segments& other = pair == &a ? b : a;
+    const std::vector<int> curve = front_curves(*pair);
+    std::map<int, double> nearest;  // per curve: its closest approach to the other front
+    for (std::size_t i = 0; i < pair->size(); ++i) {
+      const auto& [p, q] = (*pair)[i];
+      for (const Vec3& x : {p, q, 0.5 * (p + q)}) {
+        d.push_back(to_segments(x, other));
+        auto [it, inserted] = nearest.try_emplace(curve[i], d.back());
+        if (!inserted) it->second = std::min(it->second, d.back());
+      }
+    }
+    for (std::size_t i = 0; i < pair->size(); ++i) {
+      const bool apart_curve = nearest[curve[i]] > apart;
+      for (int k = 0; k < 3; ++k) matched.push_back(!apart_curve);
+      if (apart_curve) g.unmatched_length += ((*pair)[i].second - (*pair)[i].first).norm();
+    }
+    for (const auto& [c, closest] : nearest) g.unmatched += closest > apart;
+  }
+  if (d.empty()) return g;
+  double matched_sum = 0;
+  std::size_t matched_count = 0;
+  for (std::size_t i = 0; i < d.size(); ++i)
+    if (matched[i]) matched_sum += d[i], ++matched_count;
+  g.matched_mean = matched_count > 0 ? matched_sum / double(matched_count) : 0;
+  std::sort(d.begin(), d.end());
   for (double x : d) g.mean += x / double(d.size());
   g.median = d[(d.size() - 1) / 2];
   g.p95 = d[std::size_t(0.95 * double(d.size() - 1))];
@@ -143,13 +200,14 @@ int main(int argc, char** argv) try {
   double factor = 4;
   double reference_hmax = 1;
   double perturbation = 1e-2;
+  bool reference_floor = false;
   std::filesystem::path fronts_dir;
   std::filesystem::path csv_path = "bench_fire_accuracy.csv";
   std::vector<std::string> overrides;
   bench::Arguments args("bench_fire_accuracy",
                         "usage: bench_fire_accuracy [--case file.toml] [--h H] [--set key=value]... [--iterations N] "
-                        "[--reference-factor 4] [--reference-hmax 1] [--floor-perturbation 0.01] [--fronts DIR] "
-                        "[-o out.csv]\n"
+                        "[--reference-factor 4] [--reference-hmax 1] [--floor-perturbation 0.01] [--reference-floor] "
+                        "[--fronts DIR] [-o out.csv]\n"
                         "  --case              fire case with max_cfl > 0 (default meshes/cases/fire_four_disks.toml)\n"
                         "  --h                 surface.h and remesh.hmax in metres (default: the case's)\n"
                         "  --set               a case key for every run, as `bodyfit run --set` (repeatable), e.g.\n"
@@ -160,6 +218,8 @@ int main(int argc, char** argv) try {
                         "                      (default 1; 0.5: a reference refined in space too)\n"
                         "  --floor-perturbation  the floor run (the band run on other meshes) multiplies hmax by\n"
                         "                      1 + this after T^0 (default 0.01; 0: no floor run)\n"
+                        "  --reference-floor   also run the reference with that perturbation: the reference's own\n"
+                        "                      floor (its gap to the reference)\n"
                         "  --fronts            directory: every run's front at every step, <run>_<step>.txt\n"
                         "  -o                  CSV, one row per run and step (default bench_fire_accuracy.csv)\n");
   args.option("--case", case_file);
@@ -169,12 +229,14 @@ int main(int argc, char** argv) try {
   args.option("--reference-factor", factor);
   args.option("--reference-hmax", reference_hmax);
   args.option("--floor-perturbation", perturbation);
+  args.flag("--reference-floor", reference_floor);
   args.option("--fronts", fronts_dir);
   args.option("-o", csv_path);
   args.parse(argc, argv);
   if (!(factor >= 1)) args.fail("--reference-factor must be at least 1");
   if (!(reference_hmax > 0 && reference_hmax <= 1)) args.fail("--reference-hmax must be in (0, 1]");
   if (!(perturbation >= 0 && perturbation < 0.5)) args.fail("--floor-perturbation must be in [0, 0.5)");
+  if (reference_floor && !(perturbation > 0)) args.fail("--reference-floor needs --floor-perturbation > 0");
   if (!fronts_dir.empty() && !std::filesystem::is_directory(fronts_dir))
     args.fail("--fronts: no directory " + fronts_dir.string());
   spdlog::set_level(spdlog::level::warn);
@@ -191,6 +253,9 @@ int main(int argc, char** argv) try {
   runs.push_back(run("band", config, max_cfl, true, iterations));
   runs.push_back(run("whole", config, max_cfl, false, iterations));
   if (perturbation > 0) runs.push_back(run("floor", config, max_cfl, true, iterations, 1 + perturbation));
+  if (reference_floor)
+    runs.push_back(run("reference_floor", config, max_cfl / factor, false, iterations,
+                       reference_hmax * (1 + perturbation)));
   const Run& reference = runs[0];
   const double length = reference.h;
   std::map<int, const StepRecord*> by_iteration;
@@ -198,10 +263,10 @@ int main(int argc, char** argv) try {
 
   std::ofstream csv(csv_path);
   csv << "run,iteration,time,faces,substeps,components,area,ms_total,gap_mean_h,gap_median_h,gap_p95_h,gap_max_h,"
-         "offset_h,band_gap_max_h,band_gap_mean_h\n";
+         "offset_h,band_gap_max_h,band_gap_mean_h,gap_matched_mean_h,unmatched_curves,unmatched_length_h\n";
   fmt::print("{}: h = {} m, max_cfl {} (reference {} at {} × hmax), {} steps\n", case_file.string(), length,
              max_cfl, max_cfl / factor, reference_hmax, reference.steps.size());
-  fmt::print("{:>10} {:>8} {:>8} {:>9} {:>6} {:>5} | to reference / h, worst step: {:>6} {:>6} {:>6}, last: {:>6} "
+  fmt::print("{:>15} {:>8} {:>8} {:>9} {:>6} {:>5} | to reference / h, worst step: {:>6} {:>6} {:>6}, last: {:>6} "
              "{:>7} | to band, worst: {:>6} {:>6}\n",
              "run", "wall s", "ms/step", "sub-steps", "merge", "comp", "mean", "p95", "max", "median", "offset", "mean",
              "max");
@@ -214,12 +279,12 @@ int main(int argc, char** argv) try {
       auto& s = r.steps[k];
       auto it = by_iteration.find(s.iteration);
       if (it != by_iteration.end()) {
-        s.gap = front_gap(s.front, it->second->front);
+        s.gap = front_gap(s.front, it->second->front, length);
         const double length_mean = 0.5 * (front_length(s.front) + front_length(it->second->front));
         if (length_mean > 0) s.offset = (s.area - it->second->area) / length_mean;
       }
       if (&r != band && k < band->steps.size()) {
-        const FrontGap to_band = front_gap(s.front, band->steps[k].front);
+        const FrontGap to_band = front_gap(s.front, band->steps[k].front, length);
         s.band_error = to_band.max / length;
         s.band_mean = to_band.mean / length;
         worst_band = std::max(worst_band, s.band_error);
@@ -231,14 +296,15 @@ int main(int argc, char** argv) try {
       ms += s.ms;
       substeps += s.substeps;
       most = std::max(most, s.components);
-      csv << fmt::format("{},{},{},{},{},{},{:.9g},{:.1f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f}\n", r.name,
-                         s.iteration, s.time, s.faces, s.substeps, s.components, s.area, s.ms, s.gap.mean / length,
-                         s.gap.median / length, s.gap.p95 / length, s.gap.max / length, s.offset / length,
-                         s.band_error, s.band_mean);
+      csv << fmt::format("{},{},{},{},{},{},{:.9g},{:.1f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.2f}\n",
+                         r.name, s.iteration, s.time, s.faces, s.substeps, s.components, s.area, s.ms,
+                         s.gap.mean / length, s.gap.median / length, s.gap.p95 / length, s.gap.max / length,
+                         s.offset / length, s.band_error, s.band_mean, s.gap.matched_mean / length, s.gap.unmatched,
+                         s.gap.unmatched_length / length);
     }
     const double n = std::max<std::size_t>(1, r.steps.size());
     const StepRecord last = r.steps.empty() ? StepRecord{} : r.steps.back();
-    fmt::print("{:>10} {:>8.1f} {:>8.0f} {:>9.1f} {:>6} {:>5} |                               {:>6.3f} {:>6.3f} {:>6.3f}  "
+    fmt::print("{:>15} {:>8.1f} {:>8.0f} {:>9.1f} {:>6} {:>5} |                               {:>6.3f} {:>6.3f} {:>6.3f}  "
                "      {:>6.3f} {:>+7.3f} |                {:>6.3f} {:>6.3f}\n",
                r.name, r.wall_s, ms / n, substeps / n, merge_step(r), most, worst_mean, worst_p95, worst,
                last.gap.median / length, last.offset / length, worst_band_mean, worst_band);
@@ -247,6 +313,23 @@ int main(int argc, char** argv) try {
         std::ofstream f(fronts_dir / fmt::format("{}_{:03d}.txt", r.name, s.iteration));
         for (const auto& [a, b] : s.front) f << fmt::format("{} {} {} {} {} {}\n", a[0], a[1], a[2], b[0], b[1], b[2]);
       }
+  }
+  // The goal's bound, step by step: where a run's mean gap passes h/4, and the reference's own floor there.
+  const Run* own_floor = reference_floor ? &runs.back() : nullptr;
+  for (const auto& r : runs) {
+    if (&r == &reference || &r == own_floor) continue;
+    std::string over;
+    for (std::size_t k = 0; k < r.steps.size(); ++k) {
+      const double mean = r.steps[k].gap.mean / length;
+      if (mean <= 0.25) continue;
+      const FrontGap& gap = r.steps[k].gap;
+      over += fmt::format(" {} ({:.3f}; {:.3f} without {} unmatched curve(s) of {:.1f} h", r.steps[k].iteration, mean,
+                          gap.matched_mean / length, gap.unmatched, gap.unmatched_length / length);
+      if (own_floor && k < own_floor->steps.size())
+        over += fmt::format("; reference_floor {:.3f}", own_floor->steps[k].gap.mean / length);
+      over += ")";
+    }
+    fmt::print("{:>15}: mean gap over h/4 at step{}\n", r.name, over.empty() ? "s: none" : over);
   }
   fmt::print("wrote {}\n", csv_path.string());
   return 0;
