@@ -17,8 +17,8 @@
 // area, and the gap between its front and the reference's at the same time (the distances from every
 // end and midpoint of either front's edges to the other: mean, median, 95th percentile, max) and the
 // signed offset (the difference of the burnt areas over the fronts' mean length: > 0 ahead of the
-// reference), all in units of the case's h. A closed curve of either front that keeps more than h
-// from the other is "unmatched": a pocket one run has burnt out a step before the other, an island;
+// reference), all in units of the case's h. A curve of either front (closed, or ending on S's border)
+// that keeps more than h from the other is "unmatched": a pocket one run has burnt out a step before the other, an island;
 // the mean over the other curves is the matched gap. The floor run's gap to the band run is how far
 // two meshes alone take the same computation apart: the yardstick for the gap to the reference.
 //
@@ -53,7 +53,7 @@ using namespace bodyfit;
 namespace {
 
 /// Distances between two fronts: from every end and midpoint of a segment of either to the other.
-/// A closed curve of either front that keeps more than `apart` from the other (a pocket that one run
+/// A curve of either front (closed, or ending on S's border) that keeps more than `apart` from the other (a pocket that one run
 /// has burnt out and the other not yet, an island) is counted as unmatched; `matched_mean` is the
 /// mean over the other curves.
 struct FrontGap {
