@@ -9,10 +9,10 @@
 // (E against h, log-log, one line per c, with the paper's values for comparison).
 #include "bench_args.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
-#include <bodyfit/plot.hpp>
+#include <bodyfit/app/plot.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
 #include <fmt/format.h>

@@ -18,7 +18,7 @@
 #include "bench_args.hpp"
 
 #include <bodyfit/advection.hpp>
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/distance.hpp>
 #include <bodyfit/geometry.hpp>

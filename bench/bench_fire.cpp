@@ -14,9 +14,9 @@
 //     outdir/fire_perimeter.png: burnt area (km²) and front length (km) against time (min).
 #include "bench_args.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
-#include <bodyfit/plot.hpp>
+#include <bodyfit/app/plot.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
 #include <fmt/format.h>

@@ -29,7 +29,7 @@
 // DIR/<run>_<step>.txt, one segment "x0 y0 z0 x1 y1 z1" per line.
 #include "bench_args.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>

@@ -12,11 +12,11 @@
 // The case file meshes/cases/nair_lauritzen.toml runs the same at one size with `bodyfit run`.
 #include "bench_args.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
-#include <bodyfit/render.hpp>
+#include <bodyfit/app/render.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -9,6 +9,7 @@
 // with the full first remeshing.
 #include "bench_args.hpp"
 
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>

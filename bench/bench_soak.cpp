@@ -10,7 +10,7 @@
 #include "bench_args.hpp"
 #include "soak_case.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>

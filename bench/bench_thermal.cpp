@@ -10,7 +10,7 @@
 // printed and written as CSV, with the tetrahedra and surface triangles.
 #include "bench_args.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/plugin_loader.hpp>
 

@@ -1,6 +1,6 @@
 // The TOML case: validation messages (unknown keys with suggestions, missing keys, wrong types),
 // --set overrides, and the analytic initial regions.
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/parameters.hpp>

@@ -2,7 +2,7 @@
 // truncated files refused; formats 1 and 2 still read; canonicalize() gives the mesh a checkpoint
 // reads back; the cadence of `bodyfit run` (every N iterations, every S seconds, always at the end
 // and on SIGINT) and a resume after a crash between two checkpoints.
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/checkpoint_writer.hpp>
 #include <bodyfit/error.hpp>

@@ -1,5 +1,5 @@
 // ISO 8601 date-times of [time] start and of the outputs.
-#include <bodyfit/clock_time.hpp>
+#include <bodyfit/app/clock_time.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,7 +1,7 @@
 // bodyfit ensemble: members sampled from their index alone, the reduction's rasters, the same
 // bytes for any scheduling (sequential, threads, MPI ranks), restarts and failing members.
-#include <bodyfit/config.hpp>
-#include <bodyfit/ensemble.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/ensemble.hpp>
 
 #include "test_support.hpp"
 

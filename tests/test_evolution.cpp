@@ -1,7 +1,7 @@
 // The evolution loop against exact solutions: the paper's growing cap on the unit sphere (§4.2),
 // a disk growing on a plane, an interface meeting the boundary, the merge of two caps, and
 // `bodyfit run` (outputs, --resume gives the same final mesh as an uninterrupted run).
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>

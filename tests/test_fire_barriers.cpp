@@ -2,17 +2,17 @@
 #include "balbi.hpp"
 #include "barriers.hpp"
 
-#include <bodyfit/case_config.hpp>
-#include <bodyfit/config.hpp>
-#include <bodyfit/coordinate_system.hpp>
+#include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
-#include <bodyfit/raster_io.hpp>
-#include <bodyfit/vector_io.hpp>
+#include <bodyfit/app/raster_io.hpp>
+#include <bodyfit/app/vector_io.hpp>
 
 #include "test_support.hpp"
 
@@ -56,7 +56,7 @@ SurfaceMesh burn(SurfaceMesh surface, std::array<double, 3> disk, const std::str
   options.dt = dt;
   options.max_iterations = steps;
   options.remesh = remesh;
-  options.terrain = true;
+  options.height_field = true;
   options.output_dir = output_dir;
   options.max_cfl = 4;
   options.cfl_length = remesh.hmax;
@@ -198,7 +198,7 @@ TEST_CASE("coordinate systems: a model raster in another system than the DEM's i
   fuel.heights.assign(16, 1.0);
   fuel.crs = kUtm31;
   write_raster(dir / "fuel.asc", fuel);
-  const SurfaceSource surface{.dem = dir / "dem.tif", .crs = kUtm32};
+  const SurfaceSource surface{.file = dir / "dem.tif", .crs = kUtm32};
   LoadedModel model = fire_model();
   const std::string toml_text = fmt::format("[fuel]\nmap = '{}'\n", (dir / "fuel.asc").string());
   try {
@@ -293,7 +293,7 @@ TEST_CASE("coordinate systems: with the DEM reprojected to UTM, a fuel map in de
   const DemCoordinates coordinates = dem_coordinates(dir / "dem.asc", {.reproject = Reprojection::utm});
   REQUIRE(geographic_crs(coordinates.reprojected_from));
   REQUIRE(crs_label(coordinates.crs).find("EPSG:32632") == 0);
-  const SurfaceSource surface{.dem = dir / "dem.asc", .crs = coordinates.crs, .reprojected_from = coordinates.reprojected_from};
+  const SurfaceSource surface{.file = dir / "dem.asc", .crs = coordinates.crs, .reprojected_from = coordinates.reprojected_from};
 
   // A flat mesh in UTM metres over the block's surroundings; no wind: R = R0 on fuel 1, 0 on fuel 2.
   std::vector<PlanPoint> centre = {{6.03, 50.0}};
@@ -305,7 +305,7 @@ TEST_CASE("coordinate systems: with the DEM reprojected to UTM, a fuel map in de
                   surface);
   ScalarField distance(mesh.n_vertices(), 1.0);
   StandaloneStep where;
-  where.terrain = true;
+  where.height_field = true;
   const StepContext context = StepContext::standalone(mesh, distance, where);
   const VelocityField field = model->compute(context);
   // Where each vertex lies in degrees (GDAL's transformation), against the speed the warped map gave it.

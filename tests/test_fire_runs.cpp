@@ -2,18 +2,18 @@
 #include "balbi.hpp"
 #include "fire_maps.hpp"
 
-#include <bodyfit/case_config.hpp>
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/plan_geometry.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
-#include <bodyfit/vector_io.hpp>
-#include <bodyfit/render.hpp>
+#include <bodyfit/app/vector_io.hpp>
+#include <bodyfit/app/render.hpp>
 
 #include "gis_module.hpp"
 #include "test_support.hpp"
@@ -71,7 +71,7 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   options.dt = dt;
   options.max_iterations = steps;
   options.remesh = remesh;
-  options.terrain = true;
+  options.height_field = true;
   options.output_dir = output_dir;
   options.max_cfl = max_cfl;
   options.narrow_band = narrow_band;

@@ -3,10 +3,10 @@
 // against the uniform wind they must reproduce, and a resumed run equal to an uninterrupted one.
 #include "wind.hpp"
 
-#include <bodyfit/clock_time.hpp>
+#include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 #include <bodyfit/projection.hpp>
@@ -72,7 +72,7 @@ FireRun burn(SurfaceMesh surface, std::array<double, 3> disk, const std::string&
   options.dt = dt;
   options.max_iterations = steps;
   options.remesh = remesh;
-  options.terrain = true;
+  options.height_field = true;
   options.max_cfl = 1.0;
   options.cfl_length = remesh.hmax;
   FireRun run;
@@ -104,7 +104,7 @@ ScalarField rates_at(const std::string& model_toml, double time, std::optional<d
   LoadedModel model = load_plugin_file(fs::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
   configure_model(model, toml::parse(model_toml));
   const StepContext context =
-      StepContext::standalone(mesh, distance, {.time = time, .dt = 10, .iteration = 0, .output_dir = {}, .terrain = false, .clock_start = clock_start});
+      StepContext::standalone(mesh, distance, {.time = time, .dt = 10, .iteration = 0, .output_dir = {}, .height_field = false, .clock_start = clock_start});
   return model->compute(context).normal_speed;
 }
 

@@ -1,9 +1,10 @@
 // Generators: geodesic spheres (counts, quality, radius, topology), flat squares (counts, flatness,
 // boundary, quality), procedural terrains (boundary, topology, heights, reproducibility, edge
 // lengths), DEM rasters (.asc, GeoTIFF).
-#include <bodyfit/case_config.hpp>
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 

@@ -1,13 +1,13 @@
 // Ignitions from a vector layer ([region] shape = "ignitions"): points as disks, lines as buffers,
 // polygons as they are, each at its time; late ones join G when their time comes; a start
 // date-time ([time] start) for times given as clock times.
-#include <bodyfit/case_config.hpp>
-#include <bodyfit/clock_time.hpp>
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/clock_time.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
-#include <bodyfit/plan_geometry.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
 #include "test_support.hpp"

@@ -2,7 +2,7 @@
 // halved, the run still ends at its final time), stops the run, drives Δt and keeps state across a
 // resume; and a fire run interrupted (SIGINT, kill -9) and resumed ends byte-identical to the
 // uninterrupted one.
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>

@@ -4,13 +4,14 @@
 // the scale bar's length.
 #include "test_support.hpp"
 
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/map.hpp>
-#include <bodyfit/render.hpp>
+#include <bodyfit/app/map.hpp>
+#include <bodyfit/app/render.hpp>
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>

@@ -2,7 +2,7 @@
 // suite uses (scripts/bench_suite.sh: stages against faces, log-log, legend at the top left).
 #include "test_support.hpp"
 
-#include <bodyfit/plot.hpp>
+#include <bodyfit/app/plot.hpp>
 
 #include <doctest/doctest.h>
 

@@ -1,6 +1,6 @@
 // How a process was started, read from its environment (process_group.hpp): mpirun, a task of an
 // srun step (with PMIx, PMI-2 or no interface), another PMI launcher, a SLURM batch script.
-#include <bodyfit/process_group.hpp>
+#include <bodyfit/app/process_group.hpp>
 
 #include <doctest/doctest.h>
 

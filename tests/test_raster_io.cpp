@@ -1,8 +1,8 @@
 // write_raster: ESRI ASCII grids and GeoTIFFs read back through GDAL (the module's reader) with
 // their coordinate system, NODATA value and values.
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/raster_io.hpp>
+#include <bodyfit/app/raster_io.hpp>
 
 #include "gis_module.hpp"
 #include "test_support.hpp"

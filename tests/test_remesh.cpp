@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <bodyfit/evolution.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/geometry.hpp>

@@ -3,8 +3,8 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/plot.hpp>
-#include <bodyfit/render.hpp>
+#include <bodyfit/app/plot.hpp>
+#include <bodyfit/app/render.hpp>
 
 #include "test_support.hpp"
 

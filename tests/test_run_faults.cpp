@@ -3,10 +3,10 @@
 // stage exits with code 4 naming the model, the stage and the iteration, and the run resumes;
 // output directories (a previous run is refused unless --overwrite or --resume; a failed set-up
 // leaves nothing); --resume with another case is refused unless --force.
-#include <bodyfit/case_identity.hpp>
+#include <bodyfit/app/case_identity.hpp>
 #include <bodyfit/checkpoint.hpp>
-#include <bodyfit/config.hpp>
-#include <bodyfit/run_directory.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/run_directory.hpp>
 
 #include "test_support.hpp"
 

@@ -6,7 +6,7 @@
 // growth of the size of a mesh.
 #include "../bench/soak_case.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/plugin_loader.hpp>

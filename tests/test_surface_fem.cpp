@@ -204,14 +204,14 @@ TEST_CASE("StepContext: state, cached geometry and helpers") {
   SurfaceMesh sphere = make_sphere({.faces = 1280});
   ScalarField d = field(sphere, [](const Vec3& p) { return p[2]; });
   StepContext context = StepContext::standalone(
-      sphere, d, {.time = 1.5, .dt = 0.25, .iteration = 7, .output_dir = "out", .terrain = false, .clock_start = {}});
+      sphere, d, {.time = 1.5, .dt = 0.25, .iteration = 7, .output_dir = "out", .height_field = false, .clock_start = {}});
   CHECK(&context.mesh() == &sphere);
   CHECK(&context.distance() == &d);
   CHECK(context.time() == 1.5);
   CHECK(context.dt() == 0.25);
   CHECK(context.iteration() == 7);
   CHECK(context.output_dir() == "out");
-  CHECK_FALSE(context.is_terrain());
+  CHECK_FALSE(context.is_height_field());
   CHECK(context.mesh_size() == doctest::Approx(edge_length_stats(sphere).mean));
 
   double area = 0;

@@ -3,7 +3,7 @@
 // bound of the valid cells'), it stays so through a remesh, and pieces that touch at a point or are
 // tiny are dealt with; `nodata = "fill"` keeps the old nearest-valid surface.
 #include <bodyfit/error.hpp>
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/remesh.hpp>

@@ -1,10 +1,10 @@
 // Vector layers: a mesh region's outline in plan view (parts, holes, parts touching at a point)
 // written as GeoPackage and GeoJSON and read back through OGR (the GDAL module): CRS, validity,
 // feature count, areas against the mesh's; features of every kind read from a GeoJSON file.
-#include <bodyfit/config.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/plan_geometry.hpp>
-#include <bodyfit/vector_io.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
+#include <bodyfit/app/vector_io.hpp>
 
 #include "gis_module.hpp"
 #include "test_support.hpp"

@@ -2,10 +2,10 @@
 // local threads or MPI ranks, reduced into burn-probability rasters (docs/fire.md, "Ensembles").
 #include "commands.hpp"
 
-#include <bodyfit/config.hpp>
-#include <bodyfit/ensemble.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/ensemble.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/process_group.hpp>
+#include <bodyfit/app/process_group.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -7,8 +7,8 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/map.hpp>
-#include <bodyfit/raster_io.hpp>
+#include <bodyfit/app/map.hpp>
+#include <bodyfit/app/raster_io.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -3,6 +3,7 @@
 #include "validators.hpp"
 
 #include <bodyfit/error.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>

@@ -4,7 +4,7 @@
 #include "commands.hpp"
 
 #include <bodyfit/error.hpp>
-#include <bodyfit/plot.hpp>
+#include <bodyfit/app/plot.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -4,7 +4,7 @@
 #include <bodyfit/distance.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/render.hpp>
+#include <bodyfit/app/render.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>

@@ -2,18 +2,18 @@
 #include "commands.hpp"
 
 #include <bodyfit/atomic_file.hpp>
-#include <bodyfit/case_config.hpp>
-#include <bodyfit/case_identity.hpp>
+#include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/case_identity.hpp>
 #include <bodyfit/checkpoint_writer.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/fault_injection.hpp>
-#include <bodyfit/history.hpp>
+#include <bodyfit/app/history.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
-#include <bodyfit/render.hpp>
-#include <bodyfit/run_directory.hpp>
+#include <bodyfit/app/render.hpp>
+#include <bodyfit/app/run_directory.hpp>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -343,7 +343,7 @@ int run_case(const RunArguments& args) {
   SurfaceMesh& mesh = setup.mesh;
   EvolutionOptions& options = setup.options;
   options.output_dir = outdir;
-  options.terrain = config.surface.kind == SurfaceSpec::Kind::Terrain;
+  options.height_field = config.surface.kind == SurfaceSpec::Kind::Terrain;
 
   RunState start;
   std::optional<Checkpoint> resumed;

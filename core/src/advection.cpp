@@ -465,7 +465,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
         // midpoint lies in it; beyond its edges, from the face the midpoint lies in. Extending x's
         // affine V there instead under-estimates a speed that grows along the path (the rate of
         // spread up a steepening slope), and the feet of a sub-step crossing a few cells fell
-        // short: a fire's front lagged first order in the sub-step (docs/advection.md).
+        // short: a front lagged first order in the sub-step (docs/validation/advection.md).
         Location mid = x;
         for (int i = 0; i < 3; ++i) mid.b[i] = x.b[i] - 0.5 * dt * k1.d[i];
         Delta k2;

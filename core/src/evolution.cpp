@@ -497,7 +497,7 @@ class Evolution {
                                        .dt = dt,
                                        .iteration = iteration,
                                        .output_dir = options_.output_dir,
-                                       .terrain = options_.terrain,
+                                       .height_field = options_.height_field,
                                        .clock_start = options_.clock_start,
                                        .active = active,
                                        .geometry = geometry,

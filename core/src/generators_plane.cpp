@@ -13,7 +13,7 @@
 namespace bodyfit {
 namespace {
 
-// As for the terrains: beyond this the mesh would not fit in memory anyway, and the row counts
+// Beyond this the mesh would not fit in memory anyway, and the row counts
 // below must stay far from int overflow.
 constexpr double kMaxVertices = 2e7;
 

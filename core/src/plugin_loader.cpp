@@ -1,7 +1,7 @@
 // Finding plugins on the search path, dlopen-ing them, checking their ABI and creating models.
 #include <bodyfit/plugin_loader.hpp>
 
-#include "core_location.hpp"
+#include <bodyfit/shared_object.hpp>
 
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
@@ -32,11 +32,6 @@ using AbiFunction = std::uint32_t (*)();
 using CreateFunction = VelocityModel* (*)();
 using DestroyFunction = void (*)(VelocityModel*);
 
-std::string dl_error() {
-  const char* message = dlerror();
-  return message ? message : "unknown dynamic-loader error";
-}
-
 /// Closes a dlopen handle unless released (for the failure paths of load_plugin_file).
 struct HandleGuard {
   void* handle = nullptr;
@@ -47,8 +42,7 @@ struct HandleGuard {
 };
 
 void* require_symbol(void* handle, const fs::path& file, const char* symbol) {
-  dlerror();
-  void* address = dlsym(handle, symbol);
+  void* address = shared_object_symbol(handle, symbol);
   if (!address)
     throw file_error(file, fmt::format("not a bodyfit plugin: missing symbol '{}' (build it with BODYFIT_PLUGIN(YourModel))",
                                        symbol));
@@ -148,12 +142,10 @@ std::vector<fs::path> plugin_search_path() {
 LoadedModel load_plugin_file(const fs::path& file) {
   std::error_code ec;
   if (!fs::exists(file, ec)) throw file_error(file, "no such plugin file");
-  dlerror();
   // Never unloaded (RTLD_NODELETE; dlclose only drops the count): what a plugin pulls in may not
-  // survive an unload — libgomp, through the thermal plugin's CHOLMOD, keeps a block that an unload
+  // survive an unload — libgomp, through a plugin's CHOLMOD, keeps a block that an unload
   // leaks (LeakSanitizer, the sanitize stage) and thread-exit hooks into its unmapped code.
-  HandleGuard guard{dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL | RTLD_NODELETE)};
-  if (!guard.handle) throw file_error(file, "cannot load plugin: " + dl_error());
+  HandleGuard guard{open_shared_object(file, RTLD_LOCAL | RTLD_NODELETE, "plugin")};
 
   // The ABI first: nothing else of a plugin built against other headers may be trusted.
   auto abi_function = reinterpret_cast<AbiFunction>(require_symbol(guard.handle, file, "bodyfit_plugin_abi"));

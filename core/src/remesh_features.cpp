@@ -106,8 +106,8 @@ void Remesher::classify_features() {
     m_.property(hint_, v) = hint;
   });
   // Cut points lie on chords of S: put the interface on S before it becomes the reference curve
-  // (a no-op when S is the input mesh itself). Where the chords sag far from S (a steep terrain at
-  // hmax = 400 m: up to 130 m) that move can fold a thin triangle next to the cut; such a point
+  // (a no-op when S is the input mesh itself). Where the chords sag far from S (a steep height field
+  // at hmax = 400 m: up to 130 m) that move can fold a thin triangle next to the cut; such a point
   // stays where it is, within the sag of S.
   // (The feature edges are few: found in parallel, then visited in index order.)
   const auto features = collect<EdgeHandle>(ne, [&](int i, EdgeHandle& e) {

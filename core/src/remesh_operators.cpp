@@ -85,7 +85,7 @@ bool Remesher::split(EdgeHandle e) {
 // Whether new triangles (replacing the faces `replaced`, with the vertex `moved` placed at `at`)
 // fold onto a neighbour: a dihedral angle beyond 135° with an adjacent new triangle or an unchanged
 // face. The per-triangle normal tests only bound how far each triangle turns from its own old
-// normal, which on a strongly curved S (a steep terrain at 400 m) lets it turn onto a neighbour.
+// normal, which on a strongly curved S (a steep height field at 400 m) lets it turn onto a neighbour.
 bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std::span<const FaceHandle> replaced,
                      VertexHandle moved, const Vec3& at) const {
   auto position = [&](VertexHandle v) -> const Vec3& { return v == moved ? at : m_.point(v); };

@@ -93,7 +93,7 @@ void swap_properties(Range begin, Range end, std::size_t i0, std::size_t i1) {
 double spatial_disorder(const SurfaceMesh& mesh) {
   // Neighbours far apart in memory: edges whose ends' indices differ by more than a few rows of a
   // well-ordered surface mesh (√n vertices per row), whatever that order is (a generator's rows,
-  // a DEM's raster, the Z-order); elements appended by cuts and splits, and those moved into the
+  // a height grid's, the Z-order); elements appended by cuts and splits, and those moved into the
   // holes of collapses, have such edges.
   const int ne = int(mesh.n_edges());
   std::size_t live_v = 0;

@@ -109,7 +109,7 @@ StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& 
                                      .dt = where.dt,
                                      .iteration = where.iteration,
                                      .output_dir = where.output_dir,
-                                     .terrain = where.terrain,
+                                     .height_field = where.height_field,
                                      .clock_start = where.clock_start,
                                      .active = {},
                                      .geometry = nullptr,
@@ -122,7 +122,7 @@ double StepContext::time() const { return impl_->state.time; }
 double StepContext::dt() const { return impl_->state.dt; }
 int StepContext::iteration() const { return impl_->state.iteration; }
 const std::filesystem::path& StepContext::output_dir() const { return impl_->state.output_dir; }
-bool StepContext::is_terrain() const { return impl_->state.terrain; }
+bool StepContext::is_height_field() const { return impl_->state.height_field; }
 std::span<const int> StepContext::active_vertices() const { return impl_->state.active; }
 std::optional<double> StepContext::clock_start() const { return impl_->state.clock_start; }
 

@@ -23,7 +23,7 @@ struct StepState {
   double time = 0, dt = 0;
   int iteration = 0;
   std::filesystem::path output_dir;
-  bool terrain = false;                   ///< S is a height field z(x, y)
+  bool height_field = false;              ///< S is a height field z(x, y)
   std::optional<double> clock_start;      ///< seconds since the epoch at t = 0 ([time] start)
   std::span<const int> active;            ///< narrow band: where V is needed (empty: every vertex)
   StepGeometry* geometry = nullptr;       ///< shared with the other contexts of the step (optional)

@@ -1,8 +1,8 @@
 #include "barriers.hpp"
 
-#include <bodyfit/coordinate_system.hpp>
+#include <bodyfit/app/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/vector_io.hpp>
+#include <bodyfit/app/vector_io.hpp>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -36,7 +36,7 @@ Barriers Barriers::read(const BarrierOptions& options, const SurfaceSource& surf
   if (layer.crs.empty()) {
     if (!surface.crs.empty())
       spdlog::warn("{}: no coordinate system: its coordinates are taken as the surface's ({})", options.file.string(),
-                   crs_label(surface.crs, surface.dem));
+                   crs_label(surface.crs, surface.file));
   } else if (!surface.reprojected_from.empty() && !same_crs(layer.crs, surface.crs, options.file) &&
              geographic_crs(layer.crs, options.file)) {
     // The case warped its DEM from degrees to UTM: a layer in degrees follows it.
@@ -47,9 +47,9 @@ Barriers Barriers::read(const BarrierOptions& options, const SurfaceSource& surf
     transform_points(layer.crs, surface.crs, points, options.file);
     for (std::size_t i = 0; i < points.size(); ++i) *where[i] = points[i];
     spdlog::info("{}: barriers reprojected from {} to {}, the surface's", options.file.string(),
-                 crs_label(layer.crs, options.file), crs_label(surface.crs, surface.dem));
+                 crs_label(layer.crs, options.file), crs_label(surface.crs, surface.file));
   } else {
-    require_crs(layer.crs, options.file, surface.crs, surface.dem);
+    require_crs(layer.crs, options.file, surface.crs, surface.file);
   }
   Barriers barriers;
   barriers.width_ = options.width;

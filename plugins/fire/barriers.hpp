@@ -5,7 +5,7 @@
 // barrier's lines or inside one of its polygons, so that the advection cannot carry the front
 // across (docs/fire.md, "Barriers", has the argument).
 #include <bodyfit/mesh.hpp>
-#include <bodyfit/plan_geometry.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <filesystem>

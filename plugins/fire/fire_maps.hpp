@@ -1,6 +1,6 @@
 #pragma once
 // Spatial data of the fire model: raster lookups and the arrival-time raster (the wind: wind.hpp).
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/model_state.hpp>
 

@@ -6,16 +6,16 @@
 #include "fire_maps.hpp"
 #include "wind.hpp"
 
-#include <bodyfit/clock_time.hpp>
-#include <bodyfit/config.hpp>
-#include <bodyfit/coordinate_system.hpp>
+#include <bodyfit/app/clock_time.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
-#include <bodyfit/map.hpp>
+#include <bodyfit/app/map.hpp>
 #include <bodyfit/parameters.hpp>
-#include <bodyfit/plan_geometry.hpp>
-#include <bodyfit/raster_io.hpp>
-#include <bodyfit/vector_io.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
+#include <bodyfit/app/raster_io.hpp>
+#include <bodyfit/app/vector_io.hpp>
 #include <bodyfit/velocity_model.hpp>
 
 #include <fmt/format.h>
@@ -263,7 +263,7 @@ class FireModel final : public VelocityModel {
     // A wind series is a function of time: V at the time of this (sub-)step (docs/fire.md, "Wind").
     wind_.set_clock(context.clock_start());
     const double time = context.time();
-    if (context.is_terrain() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
+    if (context.is_height_field() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
 
     ScalarField speed(mesh.n_vertices(), 0.0);
     const std::span<const int> active = context.active_vertices();
@@ -326,7 +326,7 @@ class FireModel final : public VelocityModel {
     for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
     rates_ = speed;  // the state's own compute: the rates the arrival raster records in its steps
     clock_start_ = context.clock_start();
-    if (context.is_terrain()) record_perimeter(context);
+    if (context.is_height_field()) record_perimeter(context);
 
     VelocityField field = VelocityField::normal(speed);
     if (huygens_) {
@@ -493,8 +493,8 @@ class FireModel final : public VelocityModel {
     HeightGrid grid = read_dem(file, options);
     if (grid.crs.empty() && !surface_.crs.empty())
       spdlog::warn("{}: no coordinate system: its cells are taken as in the surface's ({})", file.string(),
-                   crs_label(surface_.crs, surface_.dem));
-    require_crs(grid.crs, file, surface_.crs, surface_.dem);
+                   crs_label(surface_.crs, surface_.file));
+    require_crs(grid.crs, file, surface_.crs, surface_.file);
     return grid;
   }
 

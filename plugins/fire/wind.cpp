@@ -1,6 +1,6 @@
 #include "wind.hpp"
 
-#include <bodyfit/clock_time.hpp>
+#include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/parameters.hpp>
 

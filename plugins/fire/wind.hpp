@@ -2,7 +2,7 @@
 // The wind of the fire model: a horizontal U(x, t) in m/s, static (uniform, rotating, one raster
 // pair) or a time series (one uniform wind or one raster pair per time, linearly interpolated in
 // time on the components u, v; the end values held before the first time and after the last).
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/mesh.hpp>
 
 #include <toml++/toml.h>

@@ -4,10 +4,10 @@
 // The Medit parser's in-memory entry point is private to the core's I/O sources.
 #include "../../core/src/io_internal.hpp"
 
-#include <bodyfit/case_config.hpp>
+#include <bodyfit/app/case_config.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/generators.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/io.hpp>
 
 #include <array>

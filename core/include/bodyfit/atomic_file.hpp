@@ -10,7 +10,7 @@ namespace bodyfit {
 /// check the stream and rename it over `target`. On any failure the temporary is removed and an
 /// InputError naming `target` is thrown; `target` is never left half-written.
 void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write);
-/// The same for a writer that opens the file itself (GDAL): `write` creates the temporary at the
+/// The same for a writer that opens the file itself (a library that writes by name): `write` creates the temporary at the
 /// path it is given and throws on failure; the temporary is then renamed over `target`, or removed
 /// when `write` throws.
 void write_atomically_at(const std::filesystem::path& target,

@@ -69,7 +69,7 @@ struct StateView {
   bool final;                      ///< the last state of the run
 };
 
-/// A region that joins G at a given time (a late ignition). The step that would pass `time` is
+/// A region that joins G at a given time (a source that starts later). The step that would pass `time` is
 /// shortened to end on it; the accepted state at `time` then has φ = min(d, level_set) cut into
 /// it and remeshed, before its outputs and checkpoint; the model sees the change as one more
 /// end_step with dt = 0 (φ from d to that minimum, on the state before the cut). A region whose
@@ -103,13 +103,13 @@ struct EvolutionOptions {
   /// With max_cfl: the sub-steps' redistancing keeps φ at the vertices of the faces its zero set
   /// crosses (DistanceOptions::keep_crossings), so that only the advection moves the front. false:
   /// those vertices get the distance to the P1 zero set each sub-step, which shifts the front by
-  /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/fire.md).
+  /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/validation/substeps.md).
   bool keep_crossings = true;
   /// With max_cfl: compose the sub-steps' characteristics back to the start of the step and
   /// interpolate φ^n once at the composed feet (Advector::start_composition), instead of φ at the
   /// feet of every sub-step. On a steep plane the head then lands 5 % from the exact front at 45
-  /// sub-steps per step instead of 16 %; on the four-fire case it changes nothing measurable, so it
-  /// is off by default (docs/fire.md, "Sub-steps that converge").
+  /// sub-steps per step instead of 16 %; on fronts that merge it changes nothing measurable, so it
+  /// is off by default (docs/validation/substeps.md).
   bool compose_substeps = false;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   /// CFL sub-steps one step may take (0: no limit): a Δt far beyond what the speeds allow is an
@@ -128,7 +128,7 @@ struct EvolutionOptions {
   DiscretizeOptions discretize;
   RemeshOptions remesh;          ///< set `reference` so that S never drifts
   std::filesystem::path output_dir;  ///< handed to the model (StepContext::output_dir, finish)
-  bool terrain = false;          ///< S is a height field (StepContext::is_terrain)
+  bool height_field = false;     ///< S is a height field z(x, y) (StepContext::is_height_field)
   /// Seconds since 1970-01-01T00:00:00Z at t = 0 ([time] start; StepContext::clock_start).
   std::optional<double> clock_start;
   /// Regions joining G during the run, in any order (ScheduledRegion).

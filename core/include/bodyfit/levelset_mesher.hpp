@@ -53,7 +53,7 @@ struct DiscretizeOptions {
   /// Parts cut off the old region. With `grown_from` (the signed distance d^n to the region the
   /// new one grows from, at the input's vertices; empty: off), a part of the inside region none of
   /// whose faces has a corner where d^n ≤ 0 does not meet the old region, and is given to the
-  /// outside whatever its size. A front that only grows from itself (a fire without spotting)
+  /// outside whatever its size. A front that only grows from itself (no new source ahead of it)
   /// cannot leave such a part: it is the tip of a tongue cut off its neck between two vertices.
   /// The search grows the inside parts from the interface and stops at the first face that meets
   /// the old region, so it costs in proportion to the region gained.

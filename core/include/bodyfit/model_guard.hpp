@@ -9,8 +9,8 @@
 // "model '<name>' failed in <stage> at iteration <n>: <what>" (ExitCode::Plugin), its message
 // copied while the plugin is loaded (an exception's vtable may live in the plugin); but an
 // InputError stays one, with the same words (ExitCode::Input): the contract's way for a model to
-// say that the user's input is wrong, which some models can only see once they have the mesh (the
-// thermal model: a surface that is not closed).
+// say that the user's input is wrong, which some models can only see once they have the mesh (a
+// volume model given a surface that is not closed).
 // The iteration is StepContext::iteration() of the call: n for compute and end_step on T^n, n + 1
 // for the review of the candidate T^{n+1}, the state saved or loaded for save_state/load_state, the
 // final state for finish.

@@ -1,12 +1,12 @@
 #pragma once
-// ModelState: what a velocity model keeps across a resume (arrival times, objective histories, a
-// step size), as a small keyed container the checkpoint stores and reads back bit-exactly.
+// ModelState: what a velocity model keeps across a resume (times at which points were reached, objective
+// histories, a step size), as a small keyed container the checkpoint stores and reads back bit-exactly.
 //
 //   void save_state(ModelState& s) const override {
 //     s.version = 1;                       // the model's own format version
 //     s.set("dt", dt_);                    // a number
 //     s.set("history", objective_);        // an array of numbers
-//     s.set("grid", arrival_bytes);        // a string (any bytes)
+//     s.set("grid", grid_bytes);           // a string (any bytes)
 //   }
 //   void load_state(const ModelState& s) override {
 //     if (s.version != 1) throw InputError(...);

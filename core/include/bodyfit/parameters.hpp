@@ -56,7 +56,7 @@ class Parameters {
   bool boolean(std::string_view key, bool fallback);
   std::string string(std::string_view key, std::string fallback);
   /// A file name, resolved against the directory of the file the value was parsed from (a case
-  /// file read with toml::parse_file: `fuel = "maps/fuel.asc"` next to the case works from any
+  /// file read with toml::parse_file: `field = "data/field.sol"` next to the case works from any
   /// working directory). Absolute names are kept; a value with no source file (from `--set`, or
   /// a table parsed from a string) resolves against the current working directory. The result is
   /// absolute and lexically normal; `fallback` is returned as given when the key is absent.

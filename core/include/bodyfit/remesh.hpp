@@ -20,14 +20,14 @@ class ReferenceSurface;  // projection onto the fixed input surface S (projectio
 struct RemeshOptions {
   // Sizes. 0 selects the default: the mesh's own resolution (a remesh keeps about as many faces;
   // refined only where the curvature needs it for hausd), so a unit sphere, a scan and a 50 km
-  // terrain need no tuning. Callers that cut the mesh first (discretize, run) take it from the mesh
+  // landscape need no tuning. Callers that cut the mesh first (discretize, run) take it from the mesh
   // before the cut (resolution_length), since the cut's small edges are not a resolution.
   double hmin = 0;      ///< smallest edge length (default hmax / 20)
   double hmax = 0;      ///< largest edge length (default resolution_length(mesh), geometry.hpp)
   double hausd = 0;     ///< allowed distance to the true surface and interface (default D / 1000)
   /// Allowed distance to the interface curve alone (default hausd). An evolving front is cut and
   /// remeshed every step, and each remesh may move it by this much: a moving front wants a tighter
-  /// bound than the surface's geometry does (docs/fire.md, "The floor and the interface's tolerance").
+  /// bound than the surface's geometry does (docs/validation/remeshing.md, "The interface's tolerance").
   double hausd_interface = 0;
   double hgrad = 1.3;   ///< max ratio of target sizes between neighbouring vertices
   double feature_angle = 45;  ///< dihedral angle (degrees) above which an edge is a ridge, if S's normals
@@ -84,7 +84,7 @@ void reorder_spatially(SurfaceMesh& mesh);
 
 /// How scattered `mesh` is in memory: the share of its edges whose ends' indices differ by more than
 /// 16 √(vertices) (a few rows of a well-ordered mesh, whatever the order: a generator's rows, a
-/// DEM's raster, the Z-order), counting six per deleted vertex (the holes are filled from the end).
+/// height grid's, the Z-order), counting six per deleted vertex (the holes are filled from the end).
 /// 1-5 % for a generated sphere or a Z-ordered mesh; it grows as remeshes append elements.
 /// Linear, parallel.
 double spatial_disorder(const SurfaceMesh& mesh);

@@ -72,13 +72,13 @@ struct VelocityField {
   }
 };
 
-/// What the surface S was built from (ABI 2.4; VelocityModel::set_surface): a model's own rasters
-/// and layers are checked against it, and its outputs carry its coordinate system.
+/// What the surface S was built from (VelocityModel::set_surface): a model's own data in space is
+/// checked against it, and its outputs carry its coordinate system.
 struct SurfaceSource {
-  std::filesystem::path dem{};  ///< the DEM of a terrain ("" when S is not made from one)
-  std::string crs{};            ///< the system of S's coordinates (WKT; "" when unknown)
-  /// The DEM file's own system when the case reprojected it to `crs` ([surface] reproject =
-  /// "utm"); "" when S is in the DEM's own system.
+  std::filesystem::path file{};  ///< the file S was made from, when it carries coordinates ("": none)
+  std::string crs{};             ///< the system of S's coordinates (WKT; "" when unknown)
+  /// The file's own system when the case reprojected it to `crs`; "" when S is in the file's own
+  /// system.
   std::string reprojected_from{};
 };
 
@@ -89,7 +89,7 @@ struct StandaloneStep {
   double time = 0, dt = 0;
   int iteration = 0;
   std::filesystem::path output_dir;
-  bool terrain = false;
+  bool height_field = false;          ///< StepContext::is_height_field
   std::optional<double> clock_start;  ///< StepContext::clock_start
   const ReferenceSurface* surface = nullptr;  ///< S for StepContext::surface_normals (must outlive it)
 };
@@ -112,14 +112,14 @@ class StepContext {
   const SurfaceMesh& mesh() const;     ///< T^n: regions (f:region), interface (e:interface)
   const ScalarField& distance() const; ///< signed geodesic distance d_{G^n}, < 0 inside
   /// t^n; in a CFL sub-step after the first, the sub-step's own start (t^n + the time advanced):
-  /// a model whose V depends on time (a wind series) evaluates it there.
+  /// a model whose V depends on time (data given in time) evaluates it there.
   double time() const;
   double dt() const;                   ///< Δt of this step
   int iteration() const;               ///< n
   double mesh_size() const;            ///< mean edge length h of T^n
   const std::filesystem::path& output_dir() const;  ///< where a model may write its own files
-  /// The surface's height function when it is a terrain (z coordinate), else empty.
-  bool is_terrain() const;
+  /// Whether S is a height field z(x, y) (a landscape seen from above).
+  bool is_height_field() const;
   /// The vertices where V is needed (ABI 2.1). In the CFL sub-steps after the first, the driver
   /// works in a narrow band around Σ: it reads V only at these vertices, ignores the metrics and
   /// fields, and distance() is the distance only there (beyond, its sign is right and |d| is at
@@ -157,7 +157,7 @@ class StepContext {
 };
 
 /// The state after one advection of step n (before the cut): φ^{n+1} on T^n. Models that track
-/// something through time (arrival times) use it. With CFL sub-steps there is one per sub-step.
+/// something through time (the time each point was reached) use it. With CFL sub-steps there is one per sub-step.
 struct StepOutcome {
   const SurfaceMesh& mesh;          ///< T^n
   const ScalarField& distance;      ///< d at the start of this (sub-)step
@@ -239,7 +239,7 @@ class VelocityModel {
   /// Called once when the run ends (after the last state); may write files to output_dir.
   virtual void finish(const std::filesystem::path& /*output_dir*/) {}
   /// (ABI 2.3) The names of the files the model may write in the output directory, whatever its
-  /// settings (both formats of a raster, its default names): `bodyfit run --overwrite` removes
+  /// settings (every format of a file, its default names): `bodyfit run --overwrite` removes
   /// them with the driver's own, so a replaced run leaves none of the previous run's files.
   virtual std::vector<std::string> output_files() const { return {}; }
   /// (ABI 2.4) What S was built from, given once before configure() (configure_model passes it;

@@ -1,0 +1,264 @@
+// The reduction of an ensemble: the members' files, read in index order, into rasters and the
+// member table (ensemble.hpp).
+#include <bodyfit/atomic_file.hpp>
+#include <bodyfit/app/config.hpp>
+#include <bodyfit/app/ensemble.hpp>
+#include <bodyfit/error.hpp>
+#include <bodyfit/app/render.hpp>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace bodyfit {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// A member's arrival-time raster as written: NODATA cells become NaN (read_dem would fill them).
+HeightGrid read_arrival_raster(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw file_error(file, "cannot open the member's arrival-time raster");
+  HeightGrid grid;
+  long line = 0;
+  auto header = [&](const char* expected) {
+    std::string key;
+    std::string value;
+    ++line;
+    if (!(in >> key >> value)) throw file_error(file, line, fmt::format("expected '{} <value>'", expected));
+    std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (key != expected) throw file_error(file, line, fmt::format("expected '{}', found '{}'", expected, key));
+    double v = 0;
+    const auto [end, ec] = std::from_chars(value.data(), value.data() + value.size(), v);
+    if (ec != std::errc() || end != value.data() + value.size())
+      throw file_error(file, line, fmt::format("{}: expected a number, found '{}'", expected, value));
+    return v;
+  };
+  grid.cols = std::size_t(header("ncols"));
+  grid.rows = std::size_t(header("nrows"));
+  grid.x_origin = header("xllcorner");
+  grid.y_origin = header("yllcorner");
+  grid.cell_size = header("cellsize");
+  grid.nodata = header("nodata_value");
+  grid.heights.resize(grid.cols * grid.rows);
+  std::string word;
+  for (double& value : grid.heights) {
+    if (!(in >> word)) throw file_error(file, fmt::format("truncated: expected {} × {} values", grid.rows, grid.cols));
+    const auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+    if (ec != std::errc() || end != word.data() + word.size())
+      throw file_error(file, fmt::format("expected a number, found '{}'", word));
+    if (value == grid.nodata) value = kNaN;
+  }
+  return grid;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string s = text.str();
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  return s;
+}
+
+bool same_frame(const HeightGrid& a, const HeightGrid& b) {
+  return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
+         a.cell_size == b.cell_size;
+}
+
+/// Horizontal rate of spread 1/|∇t| from the arrival times (central differences, one-sided at
+/// the edge of the reached cells); NaN where a direction has no reached neighbour or ∇t = 0 (the
+/// ignition disk, reached at t = 0 all at once).
+std::vector<double> rate_of_spread(const HeightGrid& t) {
+  std::vector<double> ros(t.heights.size(), kNaN);
+  auto value = [&](long r, long c) {
+    if (r < 0 || c < 0 || r >= long(t.rows) || c >= long(t.cols)) return kNaN;
+    return t.at(std::size_t(r), std::size_t(c));
+  };
+  auto derivative = [&](double minus, double centre, double plus) {
+    if (!std::isnan(minus) && !std::isnan(plus)) return (plus - minus) / (2 * t.cell_size);
+    if (!std::isnan(plus)) return (plus - centre) / t.cell_size;
+    if (!std::isnan(minus)) return (centre - minus) / t.cell_size;
+    return kNaN;
+  };
+  for (long r = 0; r < long(t.rows); ++r)
+    for (long c = 0; c < long(t.cols); ++c) {
+      const double centre = value(r, c);
+      if (std::isnan(centre)) continue;
+      const double dx = derivative(value(r, c - 1), centre, value(r, c + 1));
+      const double dy = derivative(value(r + 1, c), centre, value(r - 1, c));  // rows run north to south
+      const double g = std::hypot(dx, dy);
+      if (std::isfinite(g) && g > 0) ros[std::size_t(r) * t.cols + std::size_t(c)] = 1 / g;
+    }
+  return ros;
+}
+
+/// Linear interpolation between closest ranks (the "type 7" percentile of sorted values).
+double percentile(const std::vector<double>& sorted, double p) {
+  const double position = p / 100 * double(sorted.size() - 1);
+  const std::size_t below = std::size_t(std::floor(position));
+  const std::size_t above = std::min(below + 1, sorted.size() - 1);
+  return sorted[below] + (position - double(below)) * (sorted[above] - sorted[below]);
+}
+
+std::string csv_text(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
+std::string percentile_name(double p) {
+  std::string text = fmt::format("{}", p);
+  std::replace(text.begin(), text.end(), '.', '_');
+  return "arrival_p" + text;
+}
+
+void write_member_table(const fs::path& file, const EnsembleRun& run, const std::vector<MemberRecord>& records) {
+  write_atomically(file, [&](std::ostream& out) {
+    out << "index,status,ignition_x,ignition_y";
+    for (const SampledParameter& p : run.spec.parameters) out << ',' << csv_text(p.key);
+    out << ",burnt_area_m2,final_time_s,iterations,stop,error\n";
+    for (const MemberRecord& r : records) {
+      out << fmt::format("{},{},{},{}", r.index, r.ok ? "ok" : "failed", r.x, r.y);
+      for (const SampledParameter& p : run.spec.parameters) {
+        double value = kNaN;
+        for (const auto& [key, v] : r.parameters)
+          if (key == p.key) value = v;
+        out << fmt::format(",{}", value);
+      }
+      out << fmt::format(",{},{},{},{},{}\n", r.burnt_area, r.final_time, r.iterations, csv_text(r.stop),
+                         csv_text(r.error));
+    }
+  });
+}
+
+/// The burn probability from above: a block of pixels per cell, light grey where no member
+/// reached, the colormap over (0, max] elsewhere (a probability map's values are mostly small),
+/// a colour bar and a title.
+void write_probability_picture(const fs::path& file, const HeightGrid& probability, std::size_t members) {
+  const int scale = std::max(1, int(900 / std::max(probability.cols, probability.rows)));
+  const int width = int(probability.cols) * scale, height = int(probability.rows) * scale;
+  const int top = 40, bar = 110;
+  double highest = 0;
+  for (double p : probability.heights) highest = std::max(highest, p);
+  if (highest <= 0) highest = 1;
+  Image image(width + bar + 20, height + top + 10);
+  for (std::size_t r = 0; r < probability.rows; ++r)
+    for (std::size_t c = 0; c < probability.cols; ++c) {
+      const double p = probability.at(r, c);
+      const Rgb colour = p > 0 ? colormap(p / highest) : Rgb{225, 225, 225};
+      image.fill_rect(int(c) * scale, top + int(r) * scale, int(c + 1) * scale, top + int(r + 1) * scale, colour);
+    }
+  const int x0 = width + 20;
+  for (int y = 0; y < height; ++y)
+    image.fill_rect(x0, top + y, x0 + 20, top + y + 1, colormap(1.0 - double(y) / std::max(1, height - 1)));
+  image.text(x0 + 26, top, fmt::format("{:.3g}", highest), {0, 0, 0}, 2);
+  image.text(x0 + 26, top + height / 2 - 7, fmt::format("{:.3g}", highest / 2), {0, 0, 0}, 2);
+  image.text(x0 + 26, top + height - 14, "0", {0, 0, 0}, 2);
+  const std::string title = fmt::format("burn probability, {} members ({:.0f} m cells)", members, probability.cell_size);
+  image.text(4, 8, title, {0, 0, 0}, Image::text_width(title, 2) + 8 <= image.width ? 2 : 1);
+  write_png(image, file);
+}
+
+}  // namespace
+
+void write_ensemble_raster(const fs::path& file, const HeightGrid& grid, const RasterMetadata& metadata) {
+  write_raster(file, grid, metadata);
+  // The GeoTIFF a GIS opens as it is (CRS, NODATA, units), beside the ESRI grid scripts read.
+  if constexpr (config::have_gdal) write_raster(fs::path(file).replace_extension(".tif"), grid, metadata);
+}
+
+ReduceReport reduce_ensemble(const EnsembleRun& run) {
+  const std::size_t n = run.spec.members;
+  std::vector<MemberRecord> records(n);
+  ReduceReport report;
+  HeightGrid frame;
+  fs::path frame_file;
+  std::vector<std::uint32_t> reached;
+  std::vector<double> arrival_sum, ros_sum;
+  std::vector<std::uint32_t> ros_count;
+  std::vector<std::vector<double>> arrivals;  // per cell, the reaching members' times
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!read_member_record(run.outdir, i, records[i]))
+      throw InputError(fmt::format("{}: member {} has no complete result", member_record_path(run.outdir, i).string(), i));
+    if (!records[i].ok) {
+      ++report.failed;
+      continue;
+    }
+    ++report.ok;
+    const fs::path file = member_raster_path(run.outdir, i);
+    HeightGrid grid = read_arrival_raster(file);
+    if (frame.cols == 0) {
+      frame = grid;
+      frame_file = file;
+      fs::path prj = file;
+      prj.replace_extension(".prj");
+      if (fs::exists(prj)) frame.crs = read_text(prj);
+      const std::size_t cells = grid.heights.size();
+      reached.assign(cells, 0), arrival_sum.assign(cells, 0), ros_sum.assign(cells, 0), ros_count.assign(cells, 0);
+      arrivals.assign(cells, {});
+    } else if (!same_frame(frame, grid)) {
+      throw InputError(fmt::format("{} and {}: the members' arrival-time rasters differ ({} × {} cells of {} at ({}, "
+                                   "{}) against {} × {} of {} at ({}, {})): give the case [model.arrival] like or "
+                                   "cell_size",
+                                   frame_file.string(), file.string(), frame.cols, frame.rows, frame.cell_size,
+                                   frame.x_origin, frame.y_origin, grid.cols, grid.rows, grid.cell_size,
+                                   grid.x_origin, grid.y_origin));
+    }
+    const std::vector<double> ros = rate_of_spread(grid);
+    for (std::size_t c = 0; c < grid.heights.size(); ++c) {
+      const double t = grid.heights[c];
+      if (std::isnan(t)) continue;
+      ++reached[c];
+      arrival_sum[c] += t;
+      arrivals[c].push_back(t);
+      if (!std::isnan(ros[c])) ros_sum[c] += ros[c], ++ros_count[c];
+    }
+  }
+  write_member_table(run.outdir / "members.csv", run, records);
+  if (report.ok == 0) {
+    spdlog::error("no member completed: no raster written (members.csv lists the errors)");
+    return report;
+  }
+
+  auto raster = [&](auto&& value_of) {
+    HeightGrid out = frame;
+    out.nodata = -9999;
+    for (std::size_t c = 0; c < out.heights.size(); ++c) {
+      const double v = value_of(c);
+      out.heights[c] = std::isnan(v) ? out.nodata : v;
+    }
+    return out;
+  };
+  const double members = double(report.ok);
+  const HeightGrid probability = raster([&](std::size_t c) { return double(reached[c]) / members; });
+  write_ensemble_raster(run.outdir / "burn_probability.asc", probability,
+                        {.units = "1", .description = fmt::format("burn probability over {} members", report.ok)});
+  write_probability_picture(run.outdir / "burn_probability.png", probability, report.ok);
+  write_ensemble_raster(run.outdir / "arrival_mean.asc", raster([&](std::size_t c) {
+                          return reached[c] ? arrival_sum[c] / double(reached[c]) : kNaN;
+                        }),
+                        {.units = "s", .description = "mean arrival time over the members that reached the cell"});
+  for (auto& times : arrivals) std::sort(times.begin(), times.end());
+  for (double p : run.spec.percentiles)
+    write_ensemble_raster(run.outdir / (percentile_name(p) + ".asc"), raster([&](std::size_t c) {
+                            return arrivals[c].empty() ? kNaN : percentile(arrivals[c], p);
+                          }),
+                          {.units = "s", .description = fmt::format("arrival time, percentile {} over the members that "
+                                                                    "reached the cell", p)});
+  write_ensemble_raster(run.outdir / "ros_mean.asc", raster([&](std::size_t c) {
+                          return ros_count[c] ? ros_sum[c] / double(ros_count[c]) : kNaN;
+                        }),
+                        {.units = "m/s", .description = "conditional rate of spread (1/|grad t|), mean over the members"});
+  return report;
+}
+
+}  // namespace bodyfit

@@ -1,0 +1,63 @@
+#include <bodyfit/shared_object.hpp>
+
+#include <bodyfit/error.hpp>
+
+#include <fmt/format.h>
+
+#include <dlfcn.h>
+
+#include <system_error>
+
+namespace bodyfit {
+
+std::filesystem::path library_directory_of(const void* address) {
+  Dl_info info;
+  if (!dladdr(address, &info) || !info.dli_fname) return {};
+  std::error_code ec;
+  std::filesystem::path library = std::filesystem::weakly_canonical(std::filesystem::path(info.dli_fname), ec);
+  if (ec) return {};
+  return library.parent_path();
+}
+
+std::filesystem::path core_library_directory() {
+  static const char anchor = 0;  // an object of this library: dladdr names the file it came from
+  return library_directory_of(&anchor);
+}
+
+void* open_shared_object(const std::filesystem::path& file, int flags, std::string_view what) {
+  dlerror();
+  void* handle = dlopen(file.c_str(), RTLD_NOW | flags);
+  if (!handle) {
+    const char* reason = dlerror();
+    throw file_error(file, fmt::format("cannot load {}: {}", what, reason ? reason : "unknown dynamic-loader error"));
+  }
+  return handle;
+}
+
+void* shared_object_symbol(void* handle, const char* symbol) {
+  dlerror();
+  return dlsym(handle, symbol);
+}
+
+namespace detail {
+
+const void* load_module_table(const std::filesystem::path& file, const char* entry, std::uint32_t version, int flags,
+                              std::string_view what, std::string& failure) {
+  void* handle = dlopen(file.c_str(), RTLD_NOW | flags);
+  if (!handle) {
+    const char* reason = dlerror();
+    failure = fmt::format("cannot load bodyfit's {} {}: {}", what, file.string(), reason ? reason : "?");
+    return nullptr;
+  }
+  using Entry = const std::uint32_t* (*)();
+  auto function = reinterpret_cast<Entry>(shared_object_symbol(handle, entry));
+  const std::uint32_t* table = function ? function() : nullptr;  // the table starts with its version
+  if (!table || *table != version) {
+    failure = fmt::format("{} is not the {} of this bodyfit (reinstall bodyfit)", file.string(), what);
+    return nullptr;
+  }
+  return table;
+}
+
+}  // namespace detail
+}  // namespace bodyfit
