@@ -7,7 +7,7 @@
 #        DIR/<case>.ensemble/ for a case with an [ensemble] table), and list the SHA-256 of every file
 #        written in DIR/<case>.sums
 #   scripts/compare_outputs.sh compare DIR_A DIR_B                 compare two records: exit 1 and name
-#        the files when any differs
+#        the files when any differs (a file renamed with the same bytes is reported, not a difference)
 #
 # Every file is compared whole except history.csv, whose ms_* columns are wall-clock stage timings:
 # they are removed before hashing. The case file is given by its absolute path (it is quoted in the
@@ -67,19 +67,31 @@ compare() {
   local a=$1 b=$2 status=0
   for sums in "$a"/*.sums; do
     local name
-    name=$(basename "$sums")
-    if [[ ! -f "$b/$name" ]]; then
-      echo "${name%.sums}: not recorded in $b"
+    name=$(basename "$sums" .sums)
+    if [[ ! -f "$b/$name.sums" ]]; then
+      echo "$name: not recorded in $b"
       status=1
       continue
     fi
-    local differences
-    differences=$(diff <(sort -k2 "$sums") <(sort -k2 "$b/$name") | grep '^[<>]' | awk '{print $3}' | sort -u || true)
-    if [[ -n $differences ]]; then
-      echo "${name%.sums}: differs in $(echo "$differences" | tr '\n' ' ')"
+    # Files under the same name with other bytes; files under one name only, and of those, the ones
+    # whose bytes the other record holds under another name (renamed, the same content).
+    local report
+    report=$(awk 'NR == FNR { a[$2] = $1; ha[$1]++; next } { b[$2] = $1; hb[$1]++ }
+      END {
+        for (f in a) if (f in b) { if (a[f] != b[f]) changed = changed " " f }
+                     else if (a[f] in hb) renamed++; else { gone = gone " " f; ngone++ }
+        for (f in b) if (!(f in a)) { if (b[f] in ha) renamed_to++; else { added = added " " f; nadded++ } }
+        if (changed != "") printf "differs in:%s\n", changed
+        if (ngone) printf "only in the first (%d):%s\n", ngone, gone
+        if (nadded) printf "only in the second (%d):%s\n", nadded, added
+        if (renamed) printf "renamed with the same bytes: %d files\n", renamed
+      }' "$sums" "$b/$name.sums")
+    if grep -qE '^(differs|only)' <<< "$report"; then
+      echo "$name:"
+      sed 's/^/  /' <<< "$report" | cut -c1-400
       status=1
     else
-      echo "${name%.sums}: identical ($(wc -l < "$sums") files)"
+      echo "$name: identical ($(wc -l < "$sums") files${report:+; $report})"
     fi
   done
   return $status

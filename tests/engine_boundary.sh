@@ -31,7 +31,7 @@ if needed=$(readelf -d "$library" | grep NEEDED | grep -Ei 'bodyfit_app|gdal|mpi
 fi
 
 # 3. No model, raster format or fire concept named in the engine (code and comments).
-words='fire|fires|fuel|fuels|arrival|ignitions?|burn(t|ing|s)?|wildfire|balbi|rothermel|thermal|ensembles?|rasters?|geotiff|esri|dem|dems|gdal|mpi|cairo|slurm|wind|terrain|terrains'
+words='fire|fires|fuel|fuels|arrival|ignitions?|burn(t|ing|s)?|wildfire|balbi|rothermel|thermal|rasters?|geotiff|esri|dem|dems|gdal|mpi|cairo|slurm|wind|terrain|terrains'
 if hits=$(grep -nwiE "$words" $files CMakeLists.txt); then
   fail "the engine names what belongs to the application or a model:"
   echo "$hits" | head -40 >&2

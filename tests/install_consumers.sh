@@ -43,7 +43,7 @@ fi
 [[ ! -e "$prefix/include/bodyfit/config.hpp.in" ]] || fail "include/bodyfit/config.hpp.in installed"
 
 # The ABI the installed headers declare (kPluginAbi = major << 16 | minor).
-header="$prefix/include/bodyfit/velocity_model.hpp"
+header="$prefix/include/bodyfit/plugin_abi.hpp"
 major=$(sed -n 's/.*kPluginAbiMajor = \([0-9]*\);.*/\1/p' "$header")
 minor=$(sed -n 's/.*kPluginAbiMinor = \([0-9]*\);.*/\1/p' "$header")
 [[ -n "$major" && -n "$minor" ]] || fail "no kPluginAbiMajor/Minor in $header"

@@ -33,11 +33,12 @@ plugin="$work/plugin-build/bodyfit_windy.so"
 step "list it with the installed driver"
 listing=$(BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" plugins 2>&1) || { echo "$listing"; fail "bodyfit plugins"; }
 echo "$listing"
-header="$work/prefix/include/bodyfit/velocity_model.hpp"
+header="$work/prefix/include/bodyfit/plugin_abi.hpp"
 abi="$(sed -n 's/.*kPluginAbiMajor = \([0-9]*\);.*/\1/p' "$header").$(sed -n 's/.*kPluginAbiMinor = \([0-9]*\);.*/\1/p' "$header")"
-grep -q "^windy 2\.0  (ABI ${abi/./\\.})" <<< "$listing" || fail "windy not listed (with ABI $abi)"
+grep -q "^windy 3\.0  (ABI ${abi/./\\.})" <<< "$listing" || fail "windy not listed (with ABI $abi)"
 grep -qF "file: $plugin" <<< "$listing" || fail "windy not listed with its file"
-grep -qF "wind = [1, 0, 0]" <<< "$listing" || fail "windy's parameters not listed"
+described=$(BODYFIT_PLUGIN_PATH="$work/plugin-build" "$work/prefix/bin/bodyfit" plugins --describe windy 2>&1) || { echo "$described"; fail "bodyfit plugins --describe windy"; }
+grep -qF "default [1, 0, 0]" <<< "$described" || { echo "$described"; fail "windy's parameters not described"; }
 # The installed driver finds the installed conormal plugin beside its own library.
 grep -qF "$work/prefix/" <<< "$(grep -A1 '^conormal ' <<< "$listing")" || fail "installed conormal plugin not found in the prefix"
 grep -q "failed to load" <<< "$listing" && fail "some plugin failed to load"

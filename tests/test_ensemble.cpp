@@ -62,7 +62,7 @@ vtu_every = 0
 [ensemble]
 members = 5
 seed = 11
-[ensemble.ignition]
+[ensemble.region]
 polygon = [[250.0, 250.0], [950.0, 250.0], [950.0, 950.0], [250.0, 950.0]]
 radius = 150.0
 [ensemble.sample]
@@ -127,7 +127,7 @@ TEST_CASE("a member's scenario is a function of its index alone") {
   spec.seed = 11;
   spec.parameters.push_back({.key = "model.R0", .distribution = SampledParameter::Distribution::LogNormal, .a = -0.9, .b = 0.2});
   spec.parameters.push_back({.key = "model.wind.speed", .distribution = SampledParameter::Distribution::Normal, .a = 3, .b = 1, .min = 0});
-  IgnitionDomain domain;
+  PlacementDomain domain;
   domain.polygon = {{0, 0}, {100, 0}, {0, 100}};  // a triangle: some draws are rejected
   domain.xmax = domain.ymax = 100;
   domain.radius = 5;
@@ -141,7 +141,7 @@ TEST_CASE("a member's scenario is a function of its index alone") {
     CHECK(again.y == forward[i].y);
   }
   for (const MemberScenario& s : forward) {
-    REQUIRE(s.ignition_found);
+    REQUIRE(s.placed);
     CHECK(s.x + s.y <= 100);  // inside the triangle
     CHECK(s.values[0] > 0);   // lognormal
     CHECK(s.values[1] >= 0);  // truncated normal
@@ -167,7 +167,7 @@ TEST_CASE("ensemble: probabilities are multiples of 1/N and the rasters reduce t
   const Grid p50 = read_grid(dir / "out/arrival_p50.asc");
   const Grid p90 = read_grid(dir / "out/arrival_p90.asc");
   std::vector<Grid> members;
-  for (int i = 0; i < 5; ++i) members.push_back(read_grid(dir / fmt::format("out/members/m{:06d}.asc", i)));
+  for (int i = 0; i < 5; ++i) members.push_back(read_grid(dir / fmt::format("out/members/m{:06d}.arrival_time.asc", i)));
   const std::size_t n = 5;
   std::size_t some = 0;
   for (std::size_t c = 0; c < probability.values.size(); ++c) {
@@ -203,7 +203,7 @@ TEST_CASE("ensemble: probabilities are multiples of 1/N and the rasters reduce t
   std::string header;
   std::getline(table, header);
   CHECK(header ==
-        "index,status,ignition_x,ignition_y,model.R0,model.wind.direction_deg,model.wind.speed,burnt_area_m2,"
+        "index,status,region_x,region_y,model.R0,model.wind.direction_deg,model.wind.speed,burnt_area_m2,"
         "final_time_s,iterations,stop,error");
   int rows = 0;
   for (std::string row; std::getline(table, row); ++rows) CHECK(row.starts_with(fmt::format("{},ok,", rows)));

@@ -2,6 +2,7 @@
 #include "balbi.hpp"
 #include "barriers.hpp"
 
+#include <bodyfit/app/model_files.hpp>
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/app/coordinate_system.hpp>
@@ -60,8 +61,10 @@ SurfaceMesh burn(SurfaceMesh surface, std::array<double, 3> disk, const std::str
   options.output_dir = output_dir;
   options.max_cfl = 4;
   options.cfl_length = remesh.hmax;
-  evolve(surface, model.model(), options, {}, EvolutionHooks::quiet());
-  if (!output_dir.empty()) model->finish(output_dir);
+  GridFiles grids(output_dir, "asc", model->outputs(), "fire");
+  EvolutionHooks hooks = EvolutionHooks::quiet();
+  if (!output_dir.empty()) hooks.outputs = &grids;
+  evolve(surface, model.model(), options, {}, hooks);
   return surface;
 }
 
@@ -106,7 +109,7 @@ std::string geojson(const std::vector<std::string>& geometries) {
 // The fire of the barrier tests: flat ground 1600 m square, h = 20 m, a 15 m/s wind along +x, a
 // disk of 150 m at x = 400; its head reaches x = 900 + 5h within the run when nothing stops it.
 constexpr double kSize = 1600, kH = 20, kLineX = 900, kDt = 20;
-const std::string kWind = "[wind]\ntype = 'uniform'\nvelocity = [15.0, 0.0]\n[arrival]\nformat = 'asc'\n"
+const std::string kWind = "[wind]\ntype = 'uniform'\nvelocity = [15.0, 0.0]\n"
                           "[perimeters]\nfile = ''\n";
 int steps_past_the_line() {
   fire::BalbiParameters p;

@@ -2,6 +2,7 @@
 #include "balbi.hpp"
 #include "fire_maps.hpp"
 
+#include <bodyfit/app/model_files.hpp>
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
@@ -79,8 +80,10 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   options.compose_substeps = compose_substeps;
   options.cfl_length = remesh.hmax;
   FireRun run;
-  run.result = evolve(surface, model.model(), options, {}, EvolutionHooks::quiet());
-  if (!output_dir.empty()) model->finish(output_dir);
+  GridFiles grids(output_dir, "asc", model->outputs(), "fire");  // arrival_time.asc, rate_of_spread.asc
+  EvolutionHooks hooks = EvolutionHooks::quiet();
+  if (!output_dir.empty()) hooks.outputs = &grids;
+  run.result = evolve(surface, model.model(), options, {}, hooks);
   run.mesh = std::move(surface);
   return run;
 }
@@ -251,7 +254,7 @@ TEST_CASE("narrow-band sub-steps: the whole-surface computation's front and arri
   // Bumpy ground and a wind: R varies along the front and the sub-steps recompute it near the front.
   const double h = 20;
   const HeightGrid grid = bumpy_ground(h, 60);
-  const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n[arrival]\nformat = 'asc'\n";
+  const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
   test::TempDir dir_band("fire_band"), dir_whole("fire_whole");
   FireRun band = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, model, 120, 3, dir_band.path(), 0.05, 1.0);
   FireRun whole =
@@ -346,7 +349,7 @@ TEST_CASE("uniform wind as speed and direction: a wind from 270 degrees is veloc
   // speed and direction_deg are a uniform wind's, and not beside velocity.
   LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\nspeed = 3.0\ndirection_deg = 10.0\n")),
-                       doctest::Contains("apply to type = \"uniform\""), InputError);
+                       doctest::Contains("applies to type = \"uniform\""), InputError);
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nvelocity = [1.0, 0.0]\nspeed = 3.0\n"
                                                           "direction_deg = 10.0\n")),
                        doctest::Contains("either velocity or speed"), InputError);
@@ -377,7 +380,7 @@ TEST_CASE("a run on a DEM read from an ESRI ASCII grid writes arrival times") {
     }
   }
   SurfaceMesh terrain = make_terrain_from_grid(read_esri_ascii(dir / "hill.asc"), 25);
-  FireRun run = burn(std::move(terrain), {{300, 300, 100}}, "[arrival]\ncell_size = 25.0\nformat = 'asc'\n", 30, 10, dir.path());
+  FireRun run = burn(std::move(terrain), {{300, 300, 100}}, "[arrival]\ncell_size = 25.0\n", 30, 10, dir.path());
   REQUIRE(run.result.records.size() == 10);
   CHECK(run.result.records.back().area > run.result.records.front().area);
   HeightGrid arrival = read_raw_grid(dir / "arrival_time.asc");

@@ -186,7 +186,7 @@ TEST_CASE("wind series errors name the file and the line") {
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'series'\n")),
                        doctest::Contains("type = \"series\" needs file"), InputError);
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nfile = 'w.csv'\n")),
-                       doctest::Contains("file: does not apply to type \"uniform\""), InputError);
+                       doctest::Contains("[model.wind] file is not used: it applies to type = \"series\" or \"grid_series\""), InputError);
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'series'\nfile = " + toml_path(dir / "none.csv") + "\n")),
                        doctest::Contains("none.csv: cannot open"), InputError);
 }

@@ -1,6 +1,7 @@
 // Ignitions from a vector layer ([region] shape = "ignitions"): points as disks, lines as buffers,
 // polygons as they are, each at its time; late ones join G when their time comes; a start
 // date-time ([time] start) for times given as clock times.
+#include <bodyfit/app/model_files.hpp>
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/app/config.hpp>
@@ -131,10 +132,12 @@ TEST_CASE("ignitions: a late ignition joins G at its time (the step lands on it)
   REQUIRE(setup.options.clock_start);
   CHECK(format_iso8601(*setup.options.clock_start) == "2026-07-14T13:00:00Z");
   LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
-  configure_model(model, toml::parse("[arrival]\nformat = \"asc\"\n[perimeters]\nfile = \"\"\n"));
+  configure_model(model, toml::parse("[perimeters]\nfile = \"\"\n"));
   setup.options.output_dir = dir.path();
-  const EvolutionResult result = evolve(setup.mesh, model.model(), setup.options, {}, EvolutionHooks::quiet());
-  model->finish(dir.path());
+  GridFiles grids(dir.path(), "asc", model->outputs(), "fire");
+  EvolutionHooks hooks = EvolutionHooks::quiet();
+  hooks.outputs = &grids;
+  const EvolutionResult result = evolve(setup.mesh, model.model(), setup.options, {}, hooks);
   REQUIRE(result.records.size() == 3);  // 0 → 50 → 60 (the ignition) → 100
   CHECK(result.records[0].time == doctest::Approx(50));
   CHECK(result.records[1].time == doctest::Approx(60));

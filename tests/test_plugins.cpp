@@ -9,6 +9,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -53,7 +54,7 @@ TEST_CASE("search path: BODYFIT_PLUGIN_PATH entries first, then the build and in
 TEST_CASE("a good plugin loads, configures and computes") {
   LoadedModel model = load_model("testgood");
   CHECK(model->name() == "testgood");
-  CHECK(model->version() == "2.5");
+  CHECK(model->version() == "3.0");
   CHECK(model.abi() == kPluginAbi);
   CHECK(model.file().filename() == "bodyfit_testgood.so");
   configure_model(model, parse("value = 2.0"));
@@ -81,14 +82,13 @@ TEST_CASE("a plugin given by its path loads the same") {
   CHECK(model->name() == "testgood");
 }
 
-TEST_CASE("bad parameters of a good plugin: configure failed, naming the file and the key") {
+TEST_CASE("bad parameters of a good plugin: an unknown key, a value out of the declared range") {
   LoadedModel model = load_model("testgood");
   std::string message = error_of([&] { configure_model(model, parse("valeu = 2.0")); });
-  CHECK(contains(message, "bodyfit_testgood.so: configure failed: "));
   CHECK(contains(message, "unknown key 'valeu' in [model]; did you mean 'value'?"));
   message = error_of([&] { configure_model(model, parse("value = -1")); });
-  CHECK(contains(message, "configure failed"));
-  CHECK(contains(message, "value: -1 is out of range [0, inf)"));
+  CHECK(contains(message, "bodyfit_testgood.so: configure failed"));
+  CHECK(contains(message, "value: -1 is out of range [0, inf)"));  // the declared range, not restated in configure
 }
 
 TEST_CASE("a plugin missing a symbol is refused, naming the file and the symbol") {
@@ -101,7 +101,7 @@ TEST_CASE("a plugin of another ABI is refused before anything else is called") {
   // Its bodyfit_create would abort the process.
   std::string message = error_of([] { load_model("testwrongabi"); });
   CHECK(contains(message, "bodyfit_testwrongabi.so: "));
-  CHECK(contains(message, "built against plugin ABI 1.0, this bodyfit needs 2.x"));
+  CHECK(contains(message, "built against plugin ABI 1.0, this bodyfit needs 3.x"));
   CHECK(contains(message, "rebuild it"));
 }
 
@@ -143,11 +143,13 @@ TEST_CASE("discover_plugins lists the loadable plugins and reports the others") 
   };
   const PluginInfo* good = find("testgood");
   REQUIRE(good);
-  CHECK(good->version == "2.5");
+  CHECK(good->version == "3.0");
   CHECK(good->abi == kPluginAbi);
   REQUIRE(good->parameters.size() == 1);
-  CHECK(good->parameters[0].name == "value");
-  CHECK(good->parameters[0].default_value == "0.5");
+  CHECK(good->parameters[0].key == "value");
+  CHECK(good->parameters[0].default_text == "0.5");
+  REQUIRE(good->outputs.size() == 1);
+  CHECK(good->outputs[0].name == "iteration");
   CHECK(find("testthrowing"));  // it loads; only its configure fails
   const PluginInfo* conormal = find("conormal");
   REQUIRE(conormal);
@@ -159,19 +161,39 @@ TEST_CASE("discover_plugins lists the loadable plugins and reports the others") 
   CHECK(contains(failures[0] + failures[1], "bodyfit_testwrongabi.so: built against plugin ABI 1.0"));
 }
 
-TEST_CASE("bodyfit plugins lists names, versions, ABI, files, parameters and failures") {
+TEST_CASE("bodyfit plugins lists names, versions, ABI, files and failures") {
   auto result = test::run_bodyfit("plugins");
   CAPTURE(result.output);
   CHECK(result.exit_code == 0);
-  CHECK(contains(result.output, "conormal 1.0  (ABI 2.5)"));
+  CHECK(contains(result.output, "conormal 1.0  (ABI 3.0)"));
   CHECK(contains(result.output, "bodyfit_conormal.so"));
-  CHECK(contains(result.output, "speed = 1"));
-  CHECK(contains(result.output, "testgood 2.5  (ABI 2.5)"));
-  CHECK(contains(result.output, "value = 0.5"));
+  CHECK(contains(result.output, "testgood 3.0  (ABI 3.0)"));
   CHECK(contains(result.output, "constant normal speed (test)"));
   CHECK(contains(result.output, "2 files failed to load"));
   CHECK(contains(result.output, "missing symbol 'bodyfit_destroy'"));
   CHECK(contains(result.output, BODYFIT_TEST_PLUGIN_DIR));
+}
+
+TEST_CASE("bodyfit plugins --describe: a model's parameters and outputs, as text or Markdown") {
+  auto text = test::run_bodyfit("plugins --describe conormal");
+  CAPTURE(text.output);
+  REQUIRE(text.exit_code == 0);
+  CHECK(contains(text.output, "conormal 1.0  (ABI 3.0)"));
+  CHECK(contains(text.output, "speed"));
+  CHECK(contains(text.output, "default 1.0"));
+  CHECK(contains(text.output, "period"));
+  CHECK(contains(text.output, "[0, inf)"));  // the declared range
+  CHECK(contains(text.output, "history column"));
+  auto markdown = test::run_bodyfit("plugins --describe testgood --markdown");
+  CAPTURE(markdown.output);
+  REQUIRE(markdown.exit_code == 0);
+  CHECK(contains(markdown.output, "## `testgood` 3.0"));
+  CHECK(contains(markdown.output, "| `value` | number | length/time | 0.5 | [0, inf) | the normal speed |"));
+  CHECK(contains(markdown.output, "| `iteration` | history column | 1 | the state's iteration |  |"));
+  auto unknown = test::run_bodyfit("plugins --describe testgod");
+  CHECK(unknown.exit_code == 1);
+  CHECK(contains(unknown.output, "did you mean 'testgood'?"));
+  CHECK(test::run_bodyfit("plugins --markdown").exit_code == 2);  // --markdown goes with --describe
 }
 
 TEST_CASE("conormal plugin: V = speed * conormal, tangential, unknown keys refused") {
@@ -179,14 +201,16 @@ TEST_CASE("conormal plugin: V = speed * conormal, tangential, unknown keys refus
   CHECK(model->name() == "conormal");
   auto params = model->parameters();
   REQUIRE(params.size() == 3);
-  CHECK(params[0].name == "speed");
-  CHECK(params[0].default_value == "1");
-  CHECK(params[1].name == "period");  // the periodic mode (issue 14): speed·cos(2πt/period + phase)
-  CHECK(params[2].name == "phase");
-  CHECK(contains(error_of([&] { configure_model(model, parse("phase = 90")); }), "applies only with a period > 0"));
+  CHECK(params[0].key == "speed");
+  CHECK(params[0].default_text == "1.0");
+  CHECK(params[1].key == "period");  // the periodic mode: speed·cos(2πt/period + phase)
+  CHECK(params[2].key == "phase");
+  // A phase without a period takes no effect: refused, saying why.
+  CHECK(contains(error_of([&] { configure_model(model, parse("phase = 90")); }),
+                 "[model] phase is not used: it applies only with a period > 0"));
+  CHECK_NOTHROW(configure_model(model, parse("phase = 90\nperiod = 2")));
 
   std::string message = error_of([&] { configure_model(model, parse("sped = 2")); });
-  CHECK(contains(message, "bodyfit_conormal.so: configure failed: "));
   CHECK(contains(message, "unknown key 'sped' in [model]; did you mean 'speed'?"));
   message = error_of([&] { configure_model(model, parse("speed = 'fast'")); });
   CHECK(contains(message, "speed: expected a number, got a string"));
@@ -249,8 +273,107 @@ TEST_CASE("parameters: unknown key with a suggestion, or the list of known keys"
   CHECK(contains(message, "known keys: speed"));
 
   Parameters r(t, "model");
-  r.accept(std::vector<ParameterInfo>{{"speeed", "1", ""}});
+  r.accept("speeed");
   CHECK_NOTHROW(r.reject_unknown());
+}
+
+// ---- declared parameters ---------------------------------------------------------------------------
+
+namespace {
+std::vector<ParameterDecl> declarations() {
+  return {ParameterDecl::number("speed", "m/s", "a speed").fallback(2.0).at_least(0),
+          ParameterDecl::number("length", "m", "a length").computed("twice the speed"),
+          ParameterDecl::integer("count", "", "a count").fallback(3).within({.min = 1, .max = 10}),
+          ParameterDecl::choice("mode", {"fast", "exact"}, "a mode").fallback("fast"),
+          ParameterDecl::numbers("axis", 3, "", "an axis").fallback(std::vector<double>{0, 0, 1}),
+          ParameterDecl::strings("names", "some names"),
+          ParameterDecl::number("required", "", "needed").require(),
+          ParameterDecl::choice("wind.type", {"none", "uniform"}, "the wind").fallback("none"),
+          ParameterDecl::number("wind.speed", "m/s", "the wind's speed").fallback(0.0).at_least(0)};
+}
+std::string logic_error_of(auto&& action) {
+  try {
+    action();
+  } catch (const std::logic_error& e) {
+    return e.what();
+  }
+  return "(no logic_error thrown)";
+}
+}  // namespace
+
+TEST_CASE("declared parameters: defaults, ranges and choices come from the declaration") {
+  toml::table t = parse("required = 1\ncount = 7\nmode = \"exact\"\nnames = [\"a\", \"b\"]\n");
+  Parameters p(t, declarations(), "model");
+  CHECK(p.number("speed") == 2.0);            // declared default
+  CHECK(p.number("length", 4.0) == 4.0);      // a default computed by the reader
+  CHECK(p.integer("count") == 7);
+  CHECK(p.choice("mode") == "exact");
+  CHECK(p.numbers("axis") == std::vector<double>{0, 0, 1});
+  CHECK(p.strings("names") == std::vector<std::string>{"a", "b"});
+  CHECK(p.number("required") == 1);
+  CHECK_NOTHROW(p.check_consumed());
+
+  toml::table bad = parse("speed = -1\ncount = 11\nmode = \"exakt\"\naxis = [1, 2]\n");
+  Parameters q(bad, declarations(), "model");
+  CHECK(contains(error_of([&] { q.number("speed"); }), "[model] speed: -1 is out of range [0, inf)"));
+  CHECK(contains(error_of([&] { q.integer("count"); }), "[model] count: 11 is out of range [1, 10]"));
+  CHECK(contains(error_of([&] { q.choice("mode"); }), "'exakt' is not one of fast, exact; did you mean 'exact'?"));
+  CHECK(contains(error_of([&] { q.numbers("axis"); }), "axis: expected 3 numbers, got 2"));
+  CHECK(contains(error_of([&] { q.number("required"); }), "[model] required: required"));
+  CHECK(contains(error_of([&] { q.number("length", 0.0); }), "(no InputError thrown)"));  // absent: the fallback
+}
+
+TEST_CASE("declared parameters: a key read but not declared, or as another type, is the model's error") {
+  toml::table t = parse("speed = 1\n");
+  Parameters p(t, declarations(), "model");
+  CHECK(contains(logic_error_of([&] { p.number("sped"); }), "[model] sped: read, but not declared"));
+  CHECK(contains(logic_error_of([&] { p.string("speed", ""); }), "read as another type than its declaration (number)"));
+  CHECK(contains(logic_error_of([&] { p.section("speed"); }), "no parameter is declared in it"));
+  CHECK(contains(logic_error_of([&] { p.not_used("sped", "why"); }), "not declared"));
+}
+
+TEST_CASE("declared parameters: every key set is read, or refused saying why") {
+  // Read: nothing left.
+  toml::table all = parse("required = 1\n[wind]\ntype = \"uniform\"\nspeed = 3\n");
+  Parameters p(all, declarations(), "model");
+  p.number("required");
+  Parameters& wind = p.section("wind");
+  CHECK(wind.section() == "model.wind");
+  CHECK(wind.choice("type") == "uniform");
+  CHECK(wind.number("speed") == 3);
+  CHECK_NOTHROW(p.check_consumed());
+  CHECK(p.consumed() == std::vector<std::string>{"required", "wind.type", "wind.speed"});
+
+  // A declared key the settings do not use: refused, with the model's reason or a plain one.
+  toml::table unused = parse("required = 1\nlength = 2\n[wind]\nspeed = 3\n");
+  Parameters q(unused, declarations(), "model");
+  q.number("required");
+  q.not_used("length", "it is computed from the speed here");
+  CHECK(contains(error_of([&] { q.check_consumed(); }), "line 2: [model] length is not used: it is computed from the speed here"));
+  q.number("length", 0.0);
+  Parameters& calm = q.section("wind");
+  calm.choice("type");  // "none": the speed is not read
+  CHECK(contains(error_of([&] { q.check_consumed(); }), "[model.wind] speed is set but not used with these settings"));
+
+  // An unknown key, in a section too: a suggestion among the declared keys.
+  toml::table typo = parse("required = 1\n[wind]\nsped = 3\n");
+  Parameters r(typo, declarations(), "model");
+  r.number("required");
+  r.section("wind").choice("type");
+  CHECK(contains(error_of([&] { r.check_consumed(); }), "unknown key 'sped' in [model.wind]; did you mean 'speed'?"));
+}
+
+TEST_CASE("plugin ABI: features by version, one compatibility rule") {
+  CHECK(abi_compatible(kPluginAbi));
+  CHECK(abi_compatible((kPluginAbiMajor << 16) | 0));
+  CHECK_FALSE(abi_compatible(((kPluginAbiMajor + 1) << 16)));
+  CHECK_FALSE(abi_compatible((kPluginAbiMajor << 16) | (kPluginAbiMinor + 1)));
+  CHECK_FALSE(abi_compatible(2u << 16 | 5));
+  CHECK(plugin_has(kPluginAbi, kAbiDeclaredParameters));
+  CHECK_FALSE(plugin_has(2u << 16 | 5, kAbiDeclaredOutputs));
+  constexpr AbiFeature later{kPluginAbiMajor, kPluginAbiMinor + 1, "a later feature"};
+  CHECK_FALSE(plugin_has(kPluginAbi, later));
+  CHECK(abi_string(kPluginAbi) == fmt::format("{}.{}", kPluginAbiMajor, kPluginAbiMinor));
 }
 
 TEST_CASE("parameters: wrong types, out of range, required, bad choices") {

@@ -42,7 +42,6 @@ name = "fire"
 preset = "balbi2009"
 [model.arrival]
 cell_size = 200.0
-format = "asc"
 [model.perimeters]
 file = "perimeters.geojson"
 [time]
@@ -55,6 +54,7 @@ vtu_every = 1
 png_every = 0
 checkpoint_every = 1
 checkpoint_seconds = 0
+grid_format = "asc"
 )";
 
 // A disk growing on a plane under the fault model (tests/plugins/testfault.cpp), 4 iterations,
@@ -285,7 +285,7 @@ TEST_CASE("output directories: a previous run is refused unless --overwrite or -
     REQUIRE(fire.run("out").exit_code == 0);
     REQUIRE(fs::exists(fire.dir / "out" / "arrival_time.asc"));
     REQUIRE(fs::exists(fire.dir / "out" / "perimeters.geojson"));
-    auto replaced = fire.run("out", "--overwrite --set model.arrival.format='\"tif\"' "
+    auto replaced = fire.run("out", "--overwrite --set output.grid_format='\"tif\"' "
                                     "--set model.perimeters.file='\"perimeters.gpkg\"'");
     REQUIRE_MESSAGE(replaced.exit_code == 0, replaced.output);
     CHECK(fs::exists(fire.dir / "out" / "arrival_time.tif"));

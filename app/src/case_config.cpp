@@ -2,6 +2,7 @@
 // into a CaseConfig. Setting up the run from it is case_setup.cpp.
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/clock_time.hpp>
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
 #include <bodyfit/parameters.hpp>
@@ -280,6 +281,9 @@ void parse_output(const toml::table& table, OutputSpec& out) {
     out.width = int(size[0]), out.height = int(size[1]);
   out.checkpoint_every = clamp_to_int(p.integer("checkpoint_every", out.checkpoint_every, 0));
   out.checkpoint_seconds = p.number("checkpoint_seconds", out.checkpoint_seconds, {.min = 0});
+  out.grid_format = p.choice("grid_format", out.grid_format, {"tif", "asc"});
+  if (out.grid_format == "tif" && !config::have_gdal)
+    p.fail("grid_format", "GeoTIFF needs GDAL, and bodyfit was built without it: give \"asc\"");
   p.reject_unknown();
 }
 

@@ -2,6 +2,8 @@
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/ensemble.hpp>
+#include <bodyfit/app/model_files.hpp>
+#include <bodyfit/app/run.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
@@ -9,6 +11,7 @@
 #include <bodyfit/plugin_loader.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <toml++/toml.h>
 
@@ -26,7 +29,7 @@ fs::path member_stem(const fs::path& outdir, std::size_t index) {
   return outdir / "members" / fmt::format("m{:06d}", index);
 }
 
-std::string with_extension(const fs::path& stem, const char* extension) { return stem.string() + extension; }
+std::string with_extension(const fs::path& stem, const std::string& extension) { return stem.string() + extension; }
 
 std::string quoted(const std::string& text) {
   std::ostringstream out;
@@ -46,14 +49,15 @@ void write_record(const fs::path& file, const MemberRecord& r) {
     out << "# bodyfit ensemble member " << r.index << " (written last: the member is complete)\n";
     out << "index = " << r.index << "\n";
     out << "status = " << (r.ok ? "\"ok\"" : "\"failed\"") << "\n";
-    out << "ignition = [" << number(r.x) << ", " << number(r.y) << "]\n";
-    out << "burnt_area = " << number(r.burnt_area) << "\n";
+    out << "region = [" << number(r.x) << ", " << number(r.y) << "]\n";
     out << "final_time = " << number(r.final_time) << "\n";
     out << "iterations = " << r.iterations << "\n";
     out << "stop = " << quoted(r.stop) << "\n";
     out << "error = " << quoted(r.error) << "\n";
     out << "[parameters]\n";
     for (const auto& [key, value] : r.parameters) out << quoted(key) << " = " << number(value) << "\n";
+    out << "[values]\n";
+    for (const auto& [key, value] : r.values) out << quoted(key) << " = " << number(value) << "\n";
   });
 }
 
@@ -67,14 +71,23 @@ const char* error_kind(const std::exception& e) {
   }
 }
 
-/// The member's case and run; fills `record` (ok) or throws the member's error.
+/// The member's case: the user's overrides, then the member's own, then no per-state files.
+CaseConfig member_case(const EnsembleRun& run, const MemberScenario& s) {
+  std::vector<std::string> overrides = run.overrides;
+  overrides.insert(overrides.end(), s.overrides.begin(), s.overrides.end());
+  overrides.push_back("output.vtu_every=0");
+  overrides.push_back("output.png_every=0");
+  return read_case(run.case_file, overrides);
+}
+
+/// The member's run; fills `record` (ok) and writes its grids, or throws the member's error.
 /// False when interrupted.
-bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const fs::path& work, const std::atomic<bool>* stop,
+bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const std::atomic<bool>* stop,
                    MemberRecord& record) {
-  if (!s.ignition_found)
-    throw InputError(fmt::format("no ignition point found in the ignition domain after {} draws (polygon and mask "
-                                 "of [ensemble.ignition] do not overlap?)",
-                                 run.spec.ignition.max_attempts));
+  if (!s.placed)
+    throw InputError(fmt::format("no point found for G(0) after {} draws (polygon and mask of [ensemble.region] do "
+                                 "not overlap?)",
+                                 run.spec.region.max_attempts));
   for (std::size_t k = 0; k < s.values.size(); ++k)
     if (std::isnan(s.values[k]))
       throw InputError(fmt::format("[ensemble.sample] \"{}\": no draw within [min, max] in 10000 attempts",
@@ -82,43 +95,37 @@ bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const fs::pa
   if (std::find(run.inject_failures.begin(), run.inject_failures.end(), s.index) != run.inject_failures.end())
     throw NumericalError("injected failure (--inject-failure, a test hook)");
 
-  std::vector<std::string> overrides = run.overrides;
-  overrides.insert(overrides.end(), s.overrides.begin(), s.overrides.end());
-  overrides.push_back("output.vtu_every=0");
-  overrides.push_back("output.png_every=0");
-  // A member's raster is read back by the reduction only: the ESRI grid (+ .prj), and no perimeters.
-  overrides.push_back("model.arrival.format=\"asc\"");
-  overrides.push_back("model.perimeters.file=\"\"");
-  CaseConfig config = read_case(run.case_file, overrides);
-  LoadedModel model = load_model(config.model);
-  configure_model(model, config.model_parameters, case_surface_source(config));
+  const CaseConfig config = member_case(run, s);
+  LoadedModel model = load_case_model(config);
   CaseSetup setup = setup_case(config);
   if (region_area(setup.mesh, kInside) <= 0)
-    throw InputError(fmt::format("the ignition disk at ({}, {}) of radius {} covers no face of the surface (outside "
+    throw InputError(fmt::format("G(0), the disk at ({}, {}) of radius {}, covers no face of the surface (outside "
                                  "S, or smaller than its triangles)",
                                  s.x, s.y, run.domain.radius));
-  setup.options.output_dir = work;
+  setup.options.output_dir.clear();  // a member keeps no files of its own: its grids come to the ensemble
   setup.options.height_field = config.surface.kind == SurfaceSpec::Kind::Terrain;
   GuardedModel guarded(model.model(), 0);
+  KeptOutputs kept(model->outputs(), std::string(model->name()));
   EvolutionHooks hooks = EvolutionHooks::quiet();
   hooks.stop = stop;
+  hooks.outputs = &kept;
   const EvolutionResult result = evolve(setup.mesh, guarded, setup.options, {}, hooks);
   if (result.reason == StopReason::Interrupted) return false;
   if (result.reason == StopReason::Rejected) throw PluginError(result.message);
-  record.burnt_area = region_area(setup.mesh, kInside);
   record.final_time = result.time;
   record.iterations = result.iteration;
   record.stop = result.message;
-  const fs::path arrival = work / "arrival_time.asc";
-  if (!fs::exists(arrival))
-    throw InputError(fmt::format("model '{}' wrote no arrival_time.asc: an ensemble needs a model with an "
-                                 "arrival-time raster (the fire model on a terrain)",
-                                 config.model));
-  const fs::path stem = member_stem(run.outdir, s.index);
-  fs::rename(arrival, with_extension(stem, ".asc"));
-  std::error_code ec;
-  if (fs::exists(work / "arrival_time.prj")) fs::rename(work / "arrival_time.prj", with_extension(stem, ".prj"));
-  else fs::remove(with_extension(stem, ".prj"), ec);
+  for (const OutputDecl& d : run.values)
+    if (auto it = kept.values().find(d.name); it != kept.values().end()) record.values.emplace_back(d.name, it->second);
+  for (const OutputDecl& d : run.combined) {
+    auto it = kept.grids().find(d.name);
+    if (it == kept.grids().end())
+      throw PluginError(fmt::format("model '{}' gave no '{}' grid at the end of the run: an ensemble combines the "
+                                    "grids a model declares, and this run gave none",
+                                    config.model, d.name));
+    write_raster(member_grid_path(run.outdir, s.index, d.name), to_raster(it->second),
+                 raster_metadata(it->second, d.unit));
+  }
   record.ok = true;
   return true;
 }
@@ -129,12 +136,12 @@ fs::path member_record_path(const fs::path& outdir, std::size_t index) {
   return with_extension(member_stem(outdir, index), ".toml");
 }
 
-fs::path member_raster_path(const fs::path& outdir, std::size_t index) {
-  return with_extension(member_stem(outdir, index), ".asc");
+fs::path member_grid_path(const fs::path& outdir, std::size_t index, std::string_view name) {
+  return with_extension(member_stem(outdir, index), fmt::format(".{}.asc", name));
 }
 
-bool read_member_record(const fs::path& outdir, std::size_t index, MemberRecord& record) {
-  const fs::path file = member_record_path(outdir, index);
+bool read_member_record(const EnsembleRun& run, std::size_t index, MemberRecord& record) {
+  const fs::path file = member_record_path(run.outdir, index);
   std::error_code ec;
   if (!fs::exists(file, ec)) return false;
   toml::table t;
@@ -146,21 +153,48 @@ bool read_member_record(const fs::path& outdir, std::size_t index, MemberRecord&
   record = MemberRecord{};
   const auto recorded = t["index"].value<std::int64_t>();
   const auto status = t["status"].value<std::string>();
-  const toml::array* ignition = t["ignition"].as_array();
-  if (!recorded || std::size_t(*recorded) != index || !status || !ignition || ignition->size() != 2) return false;
+  const toml::array* region = t["region"].as_array();
+  if (!recorded || std::size_t(*recorded) != index || !status || !region || region->size() != 2) return false;
   record.index = index;
   record.ok = *status == "ok";
-  record.x = (*ignition)[0].value<double>().value_or(NAN);
-  record.y = (*ignition)[1].value<double>().value_or(NAN);
-  record.burnt_area = t["burnt_area"].value<double>().value_or(NAN);
+  record.x = (*region)[0].value<double>().value_or(NAN);
+  record.y = (*region)[1].value<double>().value_or(NAN);
   record.final_time = t["final_time"].value<double>().value_or(NAN);
   record.iterations = int(t["iterations"].value<std::int64_t>().value_or(0));
   record.stop = t["stop"].value<std::string>().value_or("");
   record.error = t["error"].value<std::string>().value_or("");
-  if (const toml::table* parameters = t["parameters"].as_table())
-    for (auto&& [key, value] : *parameters)
-      record.parameters.emplace_back(std::string(key.str()), value.value<double>().value_or(NAN));
-  return !record.ok || fs::exists(member_raster_path(outdir, index), ec);
+  for (const char* table : {"parameters", "values"})
+    if (const toml::table* entries = t[table].as_table())
+      for (auto&& [key, value] : *entries)
+        (std::string_view(table) == "values" ? record.values : record.parameters)
+            .emplace_back(std::string(key.str()), value.value<double>().value_or(NAN));
+  if (!record.ok) return true;
+  for (const OutputDecl& d : run.combined)
+    if (!fs::exists(member_grid_path(run.outdir, index, d.name), ec)) return false;
+  return true;
+}
+
+void check_member_case(EnsembleRun& run) {
+  const MemberScenario s = sample_member(run.spec, run.domain, 0);
+  try {
+    const CaseConfig config = member_case(run, s);
+    const LoadedModel model = load_case_model(config);
+    run.model = config.model;
+    for (const OutputDecl& d : model->outputs()) {
+      if (d.kind == OutputDecl::Kind::Grid && !d.ensemble.empty()) run.combined.push_back(d);
+      if (d.kind == OutputDecl::Kind::Value) run.values.push_back(d);
+    }
+  } catch (const InputError& e) {
+    std::vector<std::string> keys;
+    for (const SampledParameter& p : run.spec.parameters) keys.push_back(p.key);
+    throw InputError(fmt::format("the case of member 0 (with its sampled {}) is refused: {}",
+                                 keys.empty() ? std::string("region") : fmt::format("{}", fmt::join(keys, ", ")),
+                                 e.what()));
+  }
+  if (run.combined.empty())
+    throw InputError(fmt::format("{}: model '{}' declares no grid output an ensemble combines: there is nothing to "
+                                 "reduce (bodyfit plugins --describe {})",
+                                 run.case_file.string(), run.model, run.model));
 }
 
 bool run_member(const EnsembleRun& run, std::size_t index, const std::atomic<bool>* stop) {
@@ -170,17 +204,9 @@ bool run_member(const EnsembleRun& run, std::size_t index, const std::atomic<boo
   record.x = s.x, record.y = s.y;
   for (std::size_t k = 0; k < s.values.size(); ++k) record.parameters.emplace_back(run.spec.parameters[k].key, s.values[k]);
 
-  const fs::path work = with_extension(member_stem(run.outdir, index), ".work");
-  std::error_code ec;
-  fs::remove_all(work, ec);
-  fs::create_directories(work, ec);
-  if (ec) throw IoError(fmt::format("{}: cannot create the member's directory ({})", work.string(), ec.message()));
   const auto start = std::chrono::steady_clock::now();
   try {
-    if (!evolve_member(run, s, work, stop, record)) {
-      fs::remove_all(work, ec);
-      return false;
-    }
+    if (!evolve_member(run, s, stop, record)) return false;
   } catch (const IoError&) {
     throw;  // the ensemble's directory, not the member
   } catch (const std::exception& e) {
@@ -188,11 +214,10 @@ bool run_member(const EnsembleRun& run, std::size_t index, const std::atomic<boo
     record.error = fmt::format("{}: {}", error_kind(e), e.what());
   }
   write_record(member_record_path(run.outdir, index), record);
-  fs::remove_all(work, ec);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (record.ok)
-    spdlog::info("member {}: ignition ({:.1f}, {:.1f}), {} iterations, t = {}, |G| = {:.4g} ({:.1f} s)", index,
-                 record.x, record.y, record.iterations, record.final_time, record.burnt_area, seconds);
+    spdlog::info("member {}: G(0) at ({:.1f}, {:.1f}), {} iterations, t = {} ({:.1f} s)", index, record.x, record.y,
+                 record.iterations, record.final_time, seconds);
   else
     spdlog::warn("member {} failed: {}", index, record.error);
   return true;

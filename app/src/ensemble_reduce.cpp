@@ -3,6 +3,7 @@
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/app/ensemble.hpp>
+#include <bodyfit/app/model_files.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/app/render.hpp>
 
@@ -22,10 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// A member's arrival-time raster as written: NODATA cells become NaN (read_dem would fill them).
-HeightGrid read_arrival_raster(const fs::path& file) {
+/// A member's grid as written: NODATA cells become NaN (read_dem would fill them).
+HeightGrid read_member_grid(const fs::path& file) {
   std::ifstream in(file);
-  if (!in) throw file_error(file, "cannot open the member's arrival-time raster");
+  if (!in) throw file_error(file, "cannot open the member's grid");
   HeightGrid grid;
   long line = 0;
   auto header = [&](const char* expected) {
@@ -73,11 +74,11 @@ bool same_frame(const HeightGrid& a, const HeightGrid& b) {
          a.cell_size == b.cell_size;
 }
 
-/// Horizontal rate of spread 1/|∇t| from the arrival times (central differences, one-sided at
-/// the edge of the reached cells); NaN where a direction has no reached neighbour or ∇t = 0 (the
-/// ignition disk, reached at t = 0 all at once).
-std::vector<double> rate_of_spread(const HeightGrid& t) {
-  std::vector<double> ros(t.heights.size(), kNaN);
+/// The speed of a front 1/|∇t| in plan view from its times of arrival (central differences,
+/// one-sided at the edge of the reached cells); NaN where a direction has no reached neighbour or
+/// ∇t = 0 (G(0), reached at t = 0 all at once).
+std::vector<double> front_speed(const HeightGrid& t) {
+  std::vector<double> speed(t.heights.size(), kNaN);
   auto value = [&](long r, long c) {
     if (r < 0 || c < 0 || r >= long(t.rows) || c >= long(t.cols)) return kNaN;
     return t.at(std::size_t(r), std::size_t(c));
@@ -95,9 +96,9 @@ std::vector<double> rate_of_spread(const HeightGrid& t) {
       const double dx = derivative(value(r, c - 1), centre, value(r, c + 1));
       const double dy = derivative(value(r + 1, c), centre, value(r - 1, c));  // rows run north to south
       const double g = std::hypot(dx, dy);
-      if (std::isfinite(g) && g > 0) ros[std::size_t(r) * t.cols + std::size_t(c)] = 1 / g;
+      if (std::isfinite(g) && g > 0) speed[std::size_t(r) * t.cols + std::size_t(c)] = 1 / g;
     }
-  return ros;
+  return speed;
 }
 
 /// Linear interpolation between closest ranks (the "type 7" percentile of sorted values).
@@ -115,45 +116,49 @@ std::string csv_text(const std::string& text) {
   return out + "\"";
 }
 
-std::string percentile_name(double p) {
-  std::string text = fmt::format("{}", p);
-  std::replace(text.begin(), text.end(), '.', '_');
-  return "arrival_p" + text;
+/// A unit as a column name's suffix: "m²" → "m2", "m/s" → "m_per_s".
+std::string column_unit(std::string unit) {
+  for (const auto& [from, to] : {std::pair<std::string, std::string>{"²", "2"}, {"³", "3"}, {"/", "_per_"}})
+    for (std::size_t at = unit.find(from); at != std::string::npos; at = unit.find(from, at + to.size()))
+      unit.replace(at, from.size(), to);
+  return unit;
 }
 
 void write_member_table(const fs::path& file, const EnsembleRun& run, const std::vector<MemberRecord>& records) {
   write_atomically(file, [&](std::ostream& out) {
-    out << "index,status,ignition_x,ignition_y";
+    out << "index,status,region_x,region_y";
     for (const SampledParameter& p : run.spec.parameters) out << ',' << csv_text(p.key);
-    out << ",burnt_area_m2,final_time_s,iterations,stop,error\n";
+    for (const OutputDecl& d : run.values) out << ',' << csv_text(d.unit.empty() ? d.name : d.name + "_" + column_unit(d.unit));
+    out << ",final_time_s,iterations,stop,error\n";
+    auto value_of = [](const std::vector<std::pair<std::string, double>>& entries, const std::string& key) {
+      double value = kNaN;
+      for (const auto& [k, v] : entries)
+        if (k == key) value = v;
+      return value;
+    };
     for (const MemberRecord& r : records) {
       out << fmt::format("{},{},{},{}", r.index, r.ok ? "ok" : "failed", r.x, r.y);
-      for (const SampledParameter& p : run.spec.parameters) {
-        double value = kNaN;
-        for (const auto& [key, v] : r.parameters)
-          if (key == p.key) value = v;
-        out << fmt::format(",{}", value);
-      }
-      out << fmt::format(",{},{},{},{},{}\n", r.burnt_area, r.final_time, r.iterations, csv_text(r.stop),
-                         csv_text(r.error));
+      for (const SampledParameter& p : run.spec.parameters) out << fmt::format(",{}", value_of(r.parameters, p.key));
+      for (const OutputDecl& d : run.values) out << fmt::format(",{}", value_of(r.values, d.name));
+      out << fmt::format(",{},{},{},{}\n", r.final_time, r.iterations, csv_text(r.stop), csv_text(r.error));
     }
   });
 }
 
-/// The burn probability from above: a block of pixels per cell, light grey where no member
-/// reached, the colormap over (0, max] elsewhere (a probability map's values are mostly small),
-/// a colour bar and a title.
-void write_probability_picture(const fs::path& file, const HeightGrid& probability, std::size_t members) {
-  const int scale = std::max(1, int(900 / std::max(probability.cols, probability.rows)));
-  const int width = int(probability.cols) * scale, height = int(probability.rows) * scale;
+/// A share over the members from above: a block of pixels per cell, light grey where it is 0, the
+/// colormap over (0, max] elsewhere (a probability map's values are mostly small), a colour bar and
+/// a title.
+void write_share_picture(const fs::path& file, const HeightGrid& share, const std::string& what, std::size_t members) {
+  const int scale = std::max(1, int(900 / std::max(share.cols, share.rows)));
+  const int width = int(share.cols) * scale, height = int(share.rows) * scale;
   const int top = 40, bar = 110;
   double highest = 0;
-  for (double p : probability.heights) highest = std::max(highest, p);
+  for (double p : share.heights) highest = std::max(highest, p);
   if (highest <= 0) highest = 1;
   Image image(width + bar + 20, height + top + 10);
-  for (std::size_t r = 0; r < probability.rows; ++r)
-    for (std::size_t c = 0; c < probability.cols; ++c) {
-      const double p = probability.at(r, c);
+  for (std::size_t r = 0; r < share.rows; ++r)
+    for (std::size_t c = 0; c < share.cols; ++c) {
+      const double p = share.at(r, c);
       const Rgb colour = p > 0 ? colormap(p / highest) : Rgb{225, 225, 225};
       image.fill_rect(int(c) * scale, top + int(r) * scale, int(c + 1) * scale, top + int(r + 1) * scale, colour);
     }
@@ -163,9 +168,107 @@ void write_probability_picture(const fs::path& file, const HeightGrid& probabili
   image.text(x0 + 26, top, fmt::format("{:.3g}", highest), {0, 0, 0}, 2);
   image.text(x0 + 26, top + height / 2 - 7, fmt::format("{:.3g}", highest / 2), {0, 0, 0}, 2);
   image.text(x0 + 26, top + height - 14, "0", {0, 0, 0}, 2);
-  const std::string title = fmt::format("burn probability, {} members ({:.0f} m cells)", members, probability.cell_size);
+  const std::string title = fmt::format("{}, {} members ({:.0f} m cells)", what, members, share.cell_size);
   image.text(4, 8, title, {0, 0, 0}, Image::text_width(title, 2) + 8 <= image.width ? 2 : 1);
   write_png(image, file);
+}
+
+/// "{members}" and "{percentile}" of a declared description replaced.
+std::string describe(std::string text, std::size_t members, double percentile = 0) {
+  auto replace = [&](const std::string& placeholder, const std::string& value) {
+    for (std::size_t at = text.find(placeholder); at != std::string::npos; at = text.find(placeholder, at + value.size()))
+      text.replace(at, placeholder.size(), value);
+  };
+  replace("{members}", fmt::format("{}", members));
+  replace("{percentile}", fmt::format("{}", percentile));
+  return text;
+}
+
+/// One combined output: every ok member's grid, cell by cell, then its combinations written.
+void reduce_output(const EnsembleRun& run, const OutputDecl& output, const std::vector<MemberRecord>& records,
+                   std::size_t members) {
+  HeightGrid frame;
+  fs::path frame_file;
+  std::vector<std::uint32_t> reached;
+  std::vector<double> sum, speed_sum;
+  std::vector<std::uint32_t> speed_count;
+  std::vector<std::vector<double>> values;  // per cell, the members' values
+  for (const MemberRecord& record : records) {
+    if (!record.ok) continue;
+    const fs::path file = member_grid_path(run.outdir, record.index, output.name);
+    HeightGrid grid = read_member_grid(file);
+    if (frame.cols == 0) {
+      frame = grid;
+      frame_file = file;
+      fs::path prj = file;
+      prj.replace_extension(".prj");
+      if (fs::exists(prj)) frame.crs = read_text(prj);
+      const std::size_t cells = grid.heights.size();
+      reached.assign(cells, 0), sum.assign(cells, 0), speed_sum.assign(cells, 0), speed_count.assign(cells, 0);
+      values.assign(cells, {});
+    } else if (!same_frame(frame, grid)) {
+      throw InputError(fmt::format("{} and {}: the members' '{}' grids differ ({} × {} cells of {} at ({}, {}) against "
+                                   "{} × {} of {} at ({}, {})): give the model a grid that does not depend on the "
+                                   "member (bodyfit plugins --describe names its parameters)",
+                                   frame_file.string(), file.string(), output.name, frame.cols, frame.rows,
+                                   frame.cell_size, frame.x_origin, frame.y_origin, grid.cols, grid.rows,
+                                   grid.cell_size, grid.x_origin, grid.y_origin));
+    }
+    const bool wants_speed = std::any_of(output.ensemble.begin(), output.ensemble.end(),
+                                         [](const Combine& c) { return c.op == Combine::Op::FrontSpeed; });
+    const std::vector<double> speed = wants_speed ? front_speed(grid) : std::vector<double>();
+    for (std::size_t c = 0; c < grid.heights.size(); ++c) {
+      const double t = grid.heights[c];
+      if (std::isnan(t)) continue;
+      ++reached[c];
+      sum[c] += t;
+      values[c].push_back(t);
+      if (wants_speed && !std::isnan(speed[c])) speed_sum[c] += speed[c], ++speed_count[c];
+    }
+  }
+  auto raster = [&](auto&& value_of) {
+    HeightGrid out = frame;
+    out.nodata = kGridNodata;
+    for (std::size_t c = 0; c < out.heights.size(); ++c) {
+      const double v = value_of(c);
+      out.heights[c] = std::isnan(v) ? out.nodata : v;
+    }
+    return out;
+  };
+  for (auto& cell : values) std::sort(cell.begin(), cell.end());
+  for (const Combine& how : output.ensemble) {
+    const fs::path file = run.outdir / (how.name + ".asc");
+    switch (how.op) {
+      case Combine::Op::Share: {
+        const HeightGrid share = raster([&](std::size_t c) { return double(reached[c]) / double(members); });
+        write_ensemble_raster(file, share, {.units = how.unit, .description = describe(how.description, members)});
+        std::string what = how.name;
+        std::replace(what.begin(), what.end(), '_', ' ');
+        write_share_picture(run.outdir / (how.name + ".png"), share, what, members);
+        break;
+      }
+      case Combine::Op::Mean:
+        write_ensemble_raster(file, raster([&](std::size_t c) { return reached[c] ? sum[c] / double(reached[c]) : kNaN; }),
+                              {.units = how.unit, .description = describe(how.description, members)});
+        break;
+      case Combine::Op::Percentiles:
+        for (double p : run.spec.percentiles) {
+          std::string suffix = fmt::format("{}", p);
+          std::replace(suffix.begin(), suffix.end(), '.', '_');
+          write_ensemble_raster(run.outdir / (how.name + suffix + ".asc"), raster([&](std::size_t c) {
+                                  return values[c].empty() ? kNaN : percentile(values[c], p);
+                                }),
+                                {.units = how.unit, .description = describe(how.description, members, p)});
+        }
+        break;
+      case Combine::Op::FrontSpeed:
+        write_ensemble_raster(file, raster([&](std::size_t c) {
+                                return speed_count[c] ? speed_sum[c] / double(speed_count[c]) : kNaN;
+                              }),
+                              {.units = how.unit, .description = describe(how.description, members)});
+        break;
+    }
+  }
 }
 
 }  // namespace
@@ -180,84 +283,18 @@ ReduceReport reduce_ensemble(const EnsembleRun& run) {
   const std::size_t n = run.spec.members;
   std::vector<MemberRecord> records(n);
   ReduceReport report;
-  HeightGrid frame;
-  fs::path frame_file;
-  std::vector<std::uint32_t> reached;
-  std::vector<double> arrival_sum, ros_sum;
-  std::vector<std::uint32_t> ros_count;
-  std::vector<std::vector<double>> arrivals;  // per cell, the reaching members' times
   for (std::size_t i = 0; i < n; ++i) {
-    if (!read_member_record(run.outdir, i, records[i]))
+    if (!read_member_record(run, i, records[i]))
       throw InputError(fmt::format("{}: member {} has no complete result", member_record_path(run.outdir, i).string(), i));
-    if (!records[i].ok) {
-      ++report.failed;
-      continue;
-    }
-    ++report.ok;
-    const fs::path file = member_raster_path(run.outdir, i);
-    HeightGrid grid = read_arrival_raster(file);
-    if (frame.cols == 0) {
-      frame = grid;
-      frame_file = file;
-      fs::path prj = file;
-      prj.replace_extension(".prj");
-      if (fs::exists(prj)) frame.crs = read_text(prj);
-      const std::size_t cells = grid.heights.size();
-      reached.assign(cells, 0), arrival_sum.assign(cells, 0), ros_sum.assign(cells, 0), ros_count.assign(cells, 0);
-      arrivals.assign(cells, {});
-    } else if (!same_frame(frame, grid)) {
-      throw InputError(fmt::format("{} and {}: the members' arrival-time rasters differ ({} × {} cells of {} at ({}, "
-                                   "{}) against {} × {} of {} at ({}, {})): give the case [model.arrival] like or "
-                                   "cell_size",
-                                   frame_file.string(), file.string(), frame.cols, frame.rows, frame.cell_size,
-                                   frame.x_origin, frame.y_origin, grid.cols, grid.rows, grid.cell_size,
-                                   grid.x_origin, grid.y_origin));
-    }
-    const std::vector<double> ros = rate_of_spread(grid);
-    for (std::size_t c = 0; c < grid.heights.size(); ++c) {
-      const double t = grid.heights[c];
-      if (std::isnan(t)) continue;
-      ++reached[c];
-      arrival_sum[c] += t;
-      arrivals[c].push_back(t);
-      if (!std::isnan(ros[c])) ros_sum[c] += ros[c], ++ros_count[c];
-    }
+    if (records[i].ok) ++report.ok;
+    else ++report.failed;
   }
   write_member_table(run.outdir / "members.csv", run, records);
   if (report.ok == 0) {
-    spdlog::error("no member completed: no raster written (members.csv lists the errors)");
+    spdlog::error("no member completed: nothing combined (members.csv lists the errors)");
     return report;
   }
-
-  auto raster = [&](auto&& value_of) {
-    HeightGrid out = frame;
-    out.nodata = -9999;
-    for (std::size_t c = 0; c < out.heights.size(); ++c) {
-      const double v = value_of(c);
-      out.heights[c] = std::isnan(v) ? out.nodata : v;
-    }
-    return out;
-  };
-  const double members = double(report.ok);
-  const HeightGrid probability = raster([&](std::size_t c) { return double(reached[c]) / members; });
-  write_ensemble_raster(run.outdir / "burn_probability.asc", probability,
-                        {.units = "1", .description = fmt::format("burn probability over {} members", report.ok)});
-  write_probability_picture(run.outdir / "burn_probability.png", probability, report.ok);
-  write_ensemble_raster(run.outdir / "arrival_mean.asc", raster([&](std::size_t c) {
-                          return reached[c] ? arrival_sum[c] / double(reached[c]) : kNaN;
-                        }),
-                        {.units = "s", .description = "mean arrival time over the members that reached the cell"});
-  for (auto& times : arrivals) std::sort(times.begin(), times.end());
-  for (double p : run.spec.percentiles)
-    write_ensemble_raster(run.outdir / (percentile_name(p) + ".asc"), raster([&](std::size_t c) {
-                            return arrivals[c].empty() ? kNaN : percentile(arrivals[c], p);
-                          }),
-                          {.units = "s", .description = fmt::format("arrival time, percentile {} over the members that "
-                                                                    "reached the cell", p)});
-  write_ensemble_raster(run.outdir / "ros_mean.asc", raster([&](std::size_t c) {
-                          return ros_count[c] ? ros_sum[c] / double(ros_count[c]) : kNaN;
-                        }),
-                        {.units = "m/s", .description = "conditional rate of spread (1/|grad t|), mean over the members"});
+  for (const OutputDecl& output : run.combined) reduce_output(run, output, records, report.ok);
   return report;
 }
 

@@ -61,7 +61,7 @@ void prepare_directory(const EnsembleOptions& options, const std::vector<std::st
   }
   remove_stale_temporaries(options.outdir);  // a reduction killed while writing
   remove_stale_temporaries(members);
-  for (const auto& entry : fs::directory_iterator(members))
+  for (const auto& entry : fs::directory_iterator(members))  // the working directories members once had
     if (entry.path().extension() == ".work") fs::remove_all(entry.path(), ec);
 }
 
@@ -88,7 +88,8 @@ EnsembleSummary run_ensemble(const EnsembleOptions& options, const ProcessGroup&
   std::exception_ptr error;
   try {
     run.spec = read_ensemble_spec(options.case_file, overrides);
-    run.domain = make_ignition_domain(options.case_file, options.overrides, run.spec);
+    run.domain = make_placement_domain(options.case_file, options.overrides, run.spec);
+    check_member_case(run);
     if (group.rank() == 0) prepare_directory(options, overrides);
   } catch (...) {
     error = std::current_exception();
@@ -101,7 +102,7 @@ EnsembleSummary run_ensemble(const EnsembleOptions& options, const ProcessGroup&
   std::vector<std::size_t> mine;
   for (std::size_t i = std::size_t(group.rank()); i < run.spec.members; i += std::size_t(group.size())) {
     MemberRecord record;
-    if (read_member_record(run.outdir, i, record)) ++summary.skipped;
+    if (read_member_record(run, i, record)) ++summary.skipped;
     else mine.push_back(i);
   }
   if (summary.skipped)

@@ -1,5 +1,6 @@
 // An ensemble's [ensemble] table and the sampling of its members (ensemble.hpp).
 #include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/terrain.hpp>
 #include <bodyfit/app/ensemble.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
@@ -15,7 +16,8 @@ namespace {
 
 // Streams of the hash: what a draw is for (a parameter's stream is a hash of its key, so adding a
 // parameter to the case leaves the others' draws as they were).
-constexpr std::uint64_t kIgnitionStream = 0x69676e6974696f6eULL;  // "ignition"
+// The placement's stream keeps the constant it was introduced with: the same seed draws the same points.
+constexpr std::uint64_t kPlacementStream = 0x69676e6974696f6eULL;
 
 std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9e3779b97f4a7c15ULL;
@@ -41,9 +43,9 @@ SampledParameter read_sampled(const std::string& key, const toml::node& node) {
   if (!t) throw InputError(fmt::format("{}[{}]: expected a table like {{dist = \"uniform\", min = 0, max = 1}}",
                                        location_of(node), section));
   if (key.find('.') == std::string::npos || key.starts_with("ensemble.") || key.starts_with("surface.") ||
-      key.starts_with("region."))
+      key.starts_with("region.") || key.starts_with("output."))
     throw InputError(fmt::format("{}[ensemble.sample] \"{}\": expected a key of [model], [time] or a stage (the "
-                                 "surface and the region are the ensemble's own)",
+                                 "surface and the region are the ensemble's own, the outputs its members' own)",
                                  location_of(node), key));
   Parameters p(*t, section);
   SampledParameter s;
@@ -118,21 +120,16 @@ EnsembleSpec read_ensemble_spec(const std::filesystem::path& case_file, const st
     spec.members = std::size_t(p.integer("members", 100, 1, 100000000));
     spec.seed = std::uint64_t(p.integer("seed", 1, 0));
     spec.percentiles = p.numbers("percentiles", spec.percentiles, std::nullopt, {.min = 0, .max = 100});
-    if (const toml::table* ignition = p.table("ignition")) {
-      Parameters i(*ignition, "ensemble.ignition");
-      for (const auto& point : i.number_arrays("polygon", 2)) spec.ignition.polygon.push_back({point[0], point[1]});
-      if (!spec.ignition.polygon.empty() && spec.ignition.polygon.size() < 3)
-        i.fail("polygon", "expected at least 3 points [[x, y], ...]");
-      spec.ignition.mask = i.path("mask");
-      spec.ignition.radius = i.number("radius", 0, {.min = 0});
-      spec.ignition.max_attempts = int(i.integer("max_attempts", spec.ignition.max_attempts, 1, 1000000000));
-      i.reject_unknown();
+    if (const toml::table* region = p.table("region")) {
+      Parameters r(*region, "ensemble.region");
+      for (const auto& point : r.number_arrays("polygon", 2)) spec.region.polygon.push_back({point[0], point[1]});
+      if (!spec.region.polygon.empty() && spec.region.polygon.size() < 3)
+        r.fail("polygon", "expected at least 3 points [[x, y], ...]");
+      spec.region.mask = r.path("mask", "");
+      spec.region.radius = r.number("radius", 0, {.min = 0});
+      spec.region.max_attempts = int(r.integer("max_attempts", spec.region.max_attempts, 1, 1000000000));
+      r.reject_unknown();
     }
-    if (spec.ignition.mask.empty())
-      if (const toml::table* fuel = table["model"]["fuel"].as_table(); fuel && fuel->contains("map")) {
-        Parameters f(*fuel, "model.fuel");
-        spec.ignition.mask = f.path("map");  // the burnable area
-      }
     if (const toml::table* sample = p.table("sample"))
       for (auto&& [key, node] : *sample) spec.parameters.push_back(read_sampled(std::string(key.str()), node));
     p.reject_unknown();
@@ -143,11 +140,11 @@ EnsembleSpec read_ensemble_spec(const std::filesystem::path& case_file, const st
   }
 }
 
-IgnitionDomain make_ignition_domain(const std::filesystem::path& case_file, const std::vector<std::string>& overrides,
-                                    const EnsembleSpec& spec) {
-  IgnitionDomain domain;
-  domain.polygon = spec.ignition.polygon;
-  domain.radius = spec.ignition.radius;
+PlacementDomain make_placement_domain(const std::filesystem::path& case_file, const std::vector<std::string>& overrides,
+                                      const EnsembleSpec& spec) {
+  PlacementDomain domain;
+  domain.polygon = spec.region.polygon;
+  domain.radius = spec.region.radius;
   if (domain.polygon.empty() || domain.radius == 0) {
     const CaseConfig config = read_case(case_file, overrides);
     const SurfaceMesh surface = make_case_surface(config);
@@ -162,21 +159,21 @@ IgnitionDomain make_ignition_domain(const std::filesystem::path& case_file, cons
     domain.xmin = std::min(domain.xmin, p[0]), domain.xmax = std::max(domain.xmax, p[0]);
     domain.ymin = std::min(domain.ymin, p[1]), domain.ymax = std::max(domain.ymax, p[1]);
   }
-  if (!spec.ignition.mask.empty()) domain.mask = read_dem(spec.ignition.mask);
+  if (!spec.region.mask.empty()) domain.mask = read_dem(spec.region.mask);
   return domain;
 }
 
-MemberScenario sample_member(const EnsembleSpec& spec, const IgnitionDomain& domain, std::size_t index) {
+MemberScenario sample_member(const EnsembleSpec& spec, const PlacementDomain& domain, std::size_t index) {
   MemberScenario s;
   s.index = index;
-  for (int attempt = 0; attempt < spec.ignition.max_attempts; ++attempt) {
-    const double x = domain.xmin + uniform01(spec.seed, index, kIgnitionStream, 2 * std::uint64_t(attempt)) *
+  for (int attempt = 0; attempt < spec.region.max_attempts; ++attempt) {
+    const double x = domain.xmin + uniform01(spec.seed, index, kPlacementStream, 2 * std::uint64_t(attempt)) *
                                        (domain.xmax - domain.xmin);
-    const double y = domain.ymin + uniform01(spec.seed, index, kIgnitionStream, 2 * std::uint64_t(attempt) + 1) *
+    const double y = domain.ymin + uniform01(spec.seed, index, kPlacementStream, 2 * std::uint64_t(attempt) + 1) *
                                        (domain.ymax - domain.ymin);
     if (inside_polygon(domain.polygon, x, y) && mask_allows(domain.mask, x, y)) {
       s.x = x, s.y = y;
-      s.ignition_found = true;
+      s.placed = true;
       break;
     }
   }

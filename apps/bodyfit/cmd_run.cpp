@@ -9,6 +9,7 @@
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/fault_injection.hpp>
 #include <bodyfit/app/history.hpp>
+#include <bodyfit/app/model_files.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
@@ -158,6 +159,7 @@ class RunOutputs {
   RunOutputs(const CaseConfig& config, fs::path outdir, GuardedModel& model, const std::string& case_text,
              InjectedSignal inject)
       : config_(config), outdir_(std::move(outdir)), model_(model), inject_(inject),
+        files_(outdir_, config.output.grid_format, model.outputs(), std::string(model.name())),
         checkpoints_(outdir_ / "checkpoint.bin",
                      {.every = config.output.checkpoint_every, .seconds = config.output.checkpoint_seconds}, case_text),
         history_(outdir_ / "history.csv") {}
@@ -197,6 +199,7 @@ class RunOutputs {
     };
     hooks.on_failure = [this](const SurfaceMesh& m, const RunState& run) { on_failure(m, run); };
     hooks.on_end = [this](const SurfaceMesh& m, const EvolutionResult& result) { on_end(m, result); };
+    hooks.outputs = &files_;
     return hooks;
   }
 
@@ -297,6 +300,7 @@ class RunOutputs {
   const fs::path outdir_;
   GuardedModel& model_;
   const InjectedSignal inject_;
+  GridFiles files_;  ///< the model's grids, written as files when it finishes
   CheckpointWriter checkpoints_;
   RunHistory history_;
   std::optional<PvdWriter> pvd_;
@@ -363,9 +367,7 @@ int run_case(const RunArguments& args) {
 
   // From here on the directory is written.
   set_fault_iteration(start.iteration);
-  // A model built against ABI < 2.3 has no output_files() in its vtable.
-  const std::vector<std::string> model_files =
-      (model.abi() & 0xffffu) >= 3 ? model->output_files() : std::vector<std::string>();
+  const std::vector<std::string> model_files = model->output_files();
   prepare_directory(outdir, args, resumed ? start.iteration : -1, model_files);
   RunOutputs outputs(config, outdir, guarded, case_text, inject);
   if (resumed) {

@@ -20,6 +20,13 @@
 namespace bodyfit {
 namespace {
 
+/// The model's grids and values when the caller takes none.
+class DroppedOutputs final : public ModelOutputs {
+ public:
+  void grid(std::string_view, const GridField&) override {}
+  void value(std::string_view, double) override {}
+};
+
 class Stopwatch {
  public:
   double lap_ms() {
@@ -469,7 +476,9 @@ class Evolution {
       hooks_.on_state(StateView{mesh_, n_, t_, distance_, field ? &velocity : nullptr, field ? &*field : nullptr, true});
     }
     if (hooks_.on_end) hooks_.on_end(mesh_, result_);  // before finish(): a failing finish() loses nothing
-    model_.finish(options_.output_dir);
+    const StepContext final_state = context_for(mesh_, distance_, n_, t_, dt_);
+    DroppedOutputs dropped;
+    model_.finish(final_state, hooks_.outputs ? *hooks_.outputs : dropped);
     return std::move(result_);
   }
 

@@ -124,7 +124,7 @@ auto GuardedModel::guarded(const char* stage, int iteration, Call&& call) const 
   }
 }
 
-void GuardedModel::configure(const toml::table& parameters) {
+void GuardedModel::configure(Parameters& parameters) {
   guarded("configure", -1, [&] { model_.configure(parameters); });
 }
 
@@ -154,8 +154,8 @@ void GuardedModel::load_state(const ModelState& state) {
   guarded("load_state", iteration_, [&] { model_.load_state(state); });
 }
 
-void GuardedModel::finish(const std::filesystem::path& output_dir) {
-  guarded("finish", iteration_, [&] { model_.finish(output_dir); });
+void GuardedModel::finish(const StepContext& final_state, ModelOutputs& outputs) {
+  guarded("finish", iteration_, [&] { model_.finish(final_state, outputs); });
 }
 
 }  // namespace bodyfit

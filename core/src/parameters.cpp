@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+#include <stdexcept>
 
 namespace bodyfit {
 
@@ -68,6 +70,8 @@ std::string location_of(const toml::node& node) {
   return fmt::format("line {}: ", source.begin.line);
 }
 
+bool Range::unbounded() const { return std::isinf(min) && min < 0 && std::isinf(max) && max > 0; }
+
 bool Range::contains(double value) const {
   if (std::isnan(value)) return false;
   bool above = min_exclusive ? value > min : value >= min;
@@ -80,16 +84,184 @@ std::string Range::describe() const {
                      format_bound(max), max_exclusive || std::isinf(max) ? ')' : ']');
 }
 
-Parameters::Parameters(const toml::table& table, std::string section) : table_(table), section_(std::move(section)) {}
+// ---- declarations --------------------------------------------------------------------------------
+
+std::string_view to_string(ParameterType type) {
+  switch (type) {
+    case ParameterType::Number: return "number";
+    case ParameterType::Integer: return "integer";
+    case ParameterType::Boolean: return "boolean";
+    case ParameterType::String: return "string";
+    case ParameterType::Choice: return "choice";
+    case ParameterType::Path: return "file";
+    case ParameterType::Numbers: return "numbers";
+    case ParameterType::Points: return "points";
+    case ParameterType::Strings: return "strings";
+    case ParameterType::Table: return "table";
+  }
+  return "?";
+}
+
+namespace {
+ParameterDecl make_decl(std::string key, ParameterType type, std::string unit, std::string description) {
+  ParameterDecl d;
+  d.key = std::move(key);
+  d.type = type;
+  d.unit = std::move(unit);
+  d.description = std::move(description);
+  return d;
+}
+
+std::string toml_text(double value) {
+  std::string text = fmt::format("{}", value);
+  if (std::isfinite(value) && text.find_first_of(".e") == std::string::npos) text += ".0";
+  return text;
+}
+}  // namespace
+
+ParameterDecl ParameterDecl::number(std::string key, std::string unit, std::string description) {
+  return make_decl(std::move(key), ParameterType::Number, std::move(unit), std::move(description));
+}
+ParameterDecl ParameterDecl::integer(std::string key, std::string unit, std::string description) {
+  return make_decl(std::move(key), ParameterType::Integer, std::move(unit), std::move(description));
+}
+ParameterDecl ParameterDecl::boolean(std::string key, std::string description) {
+  return make_decl(std::move(key), ParameterType::Boolean, "", std::move(description));
+}
+ParameterDecl ParameterDecl::string(std::string key, std::string description) {
+  return make_decl(std::move(key), ParameterType::String, "", std::move(description));
+}
+ParameterDecl ParameterDecl::choice(std::string key, std::vector<std::string> choices, std::string description) {
+  ParameterDecl d = make_decl(std::move(key), ParameterType::Choice, "", std::move(description));
+  d.choices = std::move(choices);
+  return d;
+}
+ParameterDecl ParameterDecl::path(std::string key, std::string description) {
+  return make_decl(std::move(key), ParameterType::Path, "", std::move(description));
+}
+ParameterDecl ParameterDecl::numbers(std::string key, std::size_t size, std::string unit, std::string description) {
+  ParameterDecl d = make_decl(std::move(key), ParameterType::Numbers, std::move(unit), std::move(description));
+  d.size = size;
+  return d;
+}
+ParameterDecl ParameterDecl::points(std::string key, std::size_t size, std::string unit, std::string description) {
+  ParameterDecl d = make_decl(std::move(key), ParameterType::Points, std::move(unit), std::move(description));
+  d.size = size;
+  return d;
+}
+ParameterDecl ParameterDecl::strings(std::string key, std::string description) {
+  return make_decl(std::move(key), ParameterType::Strings, "", std::move(description));
+}
+ParameterDecl ParameterDecl::table(std::string key, std::string description) {
+  return make_decl(std::move(key), ParameterType::Table, "", std::move(description));
+}
+
+ParameterDecl ParameterDecl::fallback(double value) const {
+  ParameterDecl d = *this;
+  d.number_default = value;
+  d.default_text = toml_text(value);
+  return d;
+}
+ParameterDecl ParameterDecl::fallback(std::int64_t value) const {
+  ParameterDecl d = *this;
+  d.integer_default = value;
+  d.number_default = double(value);
+  d.default_text = fmt::format("{}", value);
+  return d;
+}
+ParameterDecl ParameterDecl::fallback(bool value) const {
+  ParameterDecl d = *this;
+  d.boolean_default = value;
+  d.default_text = value ? "true" : "false";
+  return d;
+}
+ParameterDecl ParameterDecl::fallback(const char* value) const {
+  ParameterDecl d = *this;
+  d.string_default = value;
+  std::ostringstream text;
+  text << toml::value<std::string>(value);
+  d.default_text = text.str();
+  return d;
+}
+ParameterDecl ParameterDecl::fallback(std::vector<double> values) const {
+  ParameterDecl d = *this;
+  std::vector<std::string> texts;
+  for (double v : values) texts.push_back(fmt::format("{}", v));
+  d.default_text = fmt::format("[{}]", fmt::join(texts, ", "));
+  d.numbers_default = std::move(values);
+  return d;
+}
+ParameterDecl ParameterDecl::computed(std::string phrase) const {
+  ParameterDecl d = *this;
+  d.default_text = "(" + std::move(phrase) + ")";
+  return d;
+}
+ParameterDecl ParameterDecl::within(Range accepted) const {
+  ParameterDecl d = *this;
+  d.range = accepted;
+  return d;
+}
+ParameterDecl ParameterDecl::positive() const { return within({.min = 0, .min_exclusive = true}); }
+ParameterDecl ParameterDecl::at_least(double min) const { return within({.min = min}); }
+ParameterDecl ParameterDecl::require() const {
+  ParameterDecl d = *this;
+  d.required = true;
+  return d;
+}
+
+// ---- reading -------------------------------------------------------------------------------------
+
+Parameters::Parameters(const toml::table& table, std::shared_ptr<const std::vector<ParameterDecl>> declarations,
+                       std::string section, std::string prefix)
+    : table_(table), declarations_(std::move(declarations)), section_(std::move(section)), prefix_(std::move(prefix)) {}
+
+Parameters::Parameters(const toml::table& table, std::vector<ParameterDecl> declarations, std::string section)
+    : Parameters(table, std::make_shared<const std::vector<ParameterDecl>>(std::move(declarations)), std::move(section),
+                 "") {}
+
+Parameters::Parameters(const toml::table& table, std::string section) : Parameters(table, nullptr, std::move(section), "") {}
 
 Parameters::Parameters(const toml::table* table, std::string section)
     : Parameters(table ? *table : empty_table(), std::move(section)) {}
 
+Parameters::~Parameters() = default;
+
+const std::vector<ParameterDecl>& Parameters::declarations() const {
+  static const std::vector<ParameterDecl> none;
+  return declarations_ ? *declarations_ : none;
+}
+
 bool Parameters::has(std::string_view key) const { return table_.contains(key); }
+
+bool Parameters::is_table(std::string_view key) const {
+  const toml::node* node = table_.get(key);
+  return node && node->is_table();
+}
+
+const ParameterDecl* Parameters::declaration(std::string_view key) const {
+  if (!declarations_) return nullptr;
+  const std::string full = prefix_ + std::string(key);
+  for (const ParameterDecl& d : *declarations_)
+    if (d.key == full) return &d;
+  return nullptr;
+}
 
 const toml::node* Parameters::find(std::string_view key) {
   accept(key);
   return table_.get(key);
+}
+
+const ParameterDecl* Parameters::declared(std::string_view key, std::initializer_list<ParameterType> types) const {
+  if (!declarations_) return nullptr;
+  const std::string full = prefix_ + std::string(key);
+  for (const ParameterDecl& d : *declarations_) {
+    if (d.key != full) continue;
+    if (std::find(types.begin(), types.end(), d.type) == types.end())
+      throw std::logic_error(fmt::format("[{}] {}: read as another type than its declaration ({})", section_, key,
+                                         to_string(d.type)));
+    return &d;
+  }
+  throw std::logic_error(fmt::format("[{}] {}: read, but not declared among the model's parameters", section_, key));
 }
 
 void Parameters::fail(std::string_view key, const std::string& what) const {
@@ -101,7 +273,14 @@ void Parameters::fail(const std::string& what) const {
   throw InputError(fmt::format("{}[{}] {}", location_of(table_), section_, what));
 }
 
+namespace {
+/// The range a read checks: the call's, else the declaration's.
+Range range_of(const ParameterDecl* d, const Range& given) { return d && given.unbounded() ? d->range : given; }
+}  // namespace
+
 double Parameters::number(std::string_view key, double fallback, Range range) {
+  const ParameterDecl* d = declared(key, {ParameterType::Number, ParameterType::Integer});
+  range = range_of(d, range);
   const toml::node* node = find(key);
   if (!node) return fallback;
   auto value = as_number(*node);
@@ -111,11 +290,17 @@ double Parameters::number(std::string_view key, double fallback, Range range) {
 }
 
 double Parameters::required_number(std::string_view key, Range range) {
+  range = range_of(declared(key, {ParameterType::Number, ParameterType::Integer}), range);
   if (!has(key)) fail(key, "required (a number in " + range.describe() + ")");
   return number(key, 0.0, range);
 }
 
 std::int64_t Parameters::integer(std::string_view key, std::int64_t fallback, std::int64_t min, std::int64_t max) {
+  if (const ParameterDecl* d = declared(key, {ParameterType::Integer}); d && !d->range.unbounded()) {
+    using limits = std::numeric_limits<std::int64_t>;
+    if (min == limits::min() && std::isfinite(d->range.min)) min = std::int64_t(std::ceil(d->range.min));
+    if (max == limits::max() && std::isfinite(d->range.max)) max = std::int64_t(std::floor(d->range.max));
+  }
   const toml::node* node = find(key);
   if (!node) return fallback;
   auto value = node->as_integer();
@@ -126,6 +311,7 @@ std::int64_t Parameters::integer(std::string_view key, std::int64_t fallback, st
 }
 
 bool Parameters::boolean(std::string_view key, bool fallback) {
+  declared(key, {ParameterType::Boolean});
   const toml::node* node = find(key);
   if (!node) return fallback;
   auto value = node->as_boolean();
@@ -134,6 +320,7 @@ bool Parameters::boolean(std::string_view key, bool fallback) {
 }
 
 std::string Parameters::string(std::string_view key, std::string fallback) {
+  declared(key, {ParameterType::String, ParameterType::Choice, ParameterType::Path});
   const toml::node* node = find(key);
   if (!node) return fallback;
   auto value = node->as_string();
@@ -142,6 +329,7 @@ std::string Parameters::string(std::string_view key, std::string fallback) {
 }
 
 std::filesystem::path Parameters::path(std::string_view key, std::string fallback) {
+  declared(key, {ParameterType::Path});
   const bool present = has(key);
   std::string text = string(key, std::move(fallback));
   if (!present || text.empty()) return text;
@@ -154,17 +342,22 @@ std::filesystem::path Parameters::path(std::string_view key, std::string fallbac
 }
 
 std::string Parameters::choice(std::string_view key, std::string fallback, const std::vector<std::string>& allowed) {
+  const ParameterDecl* d = declared(key, {ParameterType::Choice});
+  const std::vector<std::string>& choices = d && allowed.empty() ? d->choices : allowed;
   std::string value = string(key, std::move(fallback));
-  if (std::find(allowed.begin(), allowed.end(), value) == allowed.end()) {
+  if (std::find(choices.begin(), choices.end(), value) == choices.end()) {
     std::string hint;
-    if (auto near = closest_match(value, allowed); !near.empty()) hint = fmt::format("; did you mean '{}'?", near);
-    fail(key, fmt::format("'{}' is not one of {}{}", value, fmt::join(allowed, ", "), hint));
+    if (auto near = closest_match(value, choices); !near.empty()) hint = fmt::format("; did you mean '{}'?", near);
+    fail(key, fmt::format("'{}' is not one of {}{}", value, fmt::join(choices, ", "), hint));
   }
   return value;
 }
 
 std::vector<double> Parameters::numbers(std::string_view key, std::vector<double> fallback,
                                         std::optional<std::size_t> size, Range range) {
+  const ParameterDecl* d = declared(key, {ParameterType::Numbers});
+  range = range_of(d, range);
+  if (d && !size && d->size > 0) size = d->size;
   const toml::node* node = find(key);
   if (!node) return fallback;
   auto array = node->as_array();
@@ -181,6 +374,7 @@ std::vector<double> Parameters::numbers(std::string_view key, std::vector<double
 }
 
 std::vector<std::vector<double>> Parameters::number_arrays(std::string_view key, std::size_t size, Range range) {
+  range = range_of(declared(key, {ParameterType::Points}), range);
   const toml::node* node = find(key);
   if (!node) return {};
   auto array = node->as_array();
@@ -203,7 +397,91 @@ std::vector<std::vector<double>> Parameters::number_arrays(std::string_view key,
   return rows;
 }
 
+// ---- reading through the declaration ------------------------------------------------------------
+
+namespace {
+[[noreturn]] void no_declarations(std::string_view section, std::string_view key) {
+  throw std::logic_error(fmt::format("[{}] {}: read without a fallback, but the table has no declarations", section, key));
+}
+}  // namespace
+
+double Parameters::number(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Number, ParameterType::Integer});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && (d->required || !d->number_default)) return required_number(key);
+  return number(key, d->number_default.value_or(0.0));
+}
+
+std::int64_t Parameters::integer(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Integer});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && (d->required || !d->integer_default)) fail(key, "required (an integer)");
+  return integer(key, d->integer_default.value_or(0));
+}
+
+bool Parameters::boolean(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Boolean});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && (d->required || !d->boolean_default)) fail(key, "required (true or false)");
+  return boolean(key, d->boolean_default.value_or(false));
+}
+
+std::string Parameters::string(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::String, ParameterType::Choice, ParameterType::Path});
+  if (!d) return string(key, "");
+  if (!has(key) && d->required) fail(key, "required (a string)");
+  return string(key, d->string_default.value_or(""));
+}
+
+std::string Parameters::choice(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Choice});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && (d->required || !d->string_default))
+    fail(key, fmt::format("required (one of {})", fmt::join(d->choices, ", ")));
+  return choice(key, d->string_default.value_or(""), {});
+}
+
+std::filesystem::path Parameters::path(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Path});
+  if (!d) return path(key, "");
+  if (!has(key) && d->required) fail(key, "required (a file name)");
+  return path(key, d->string_default.value_or(""));
+}
+
+std::vector<double> Parameters::numbers(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Numbers});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && d->required) fail(key, "required (an array of numbers)");
+  return numbers(key, d->numbers_default.value_or(std::vector<double>{}));
+}
+
+std::vector<std::vector<double>> Parameters::points(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Points});
+  if (!d) no_declarations(section_, key);
+  if (!has(key) && d->required) fail(key, fmt::format("required (an array of arrays of {} numbers)", d->size));
+  return number_arrays(key, d->size);
+}
+
+std::vector<std::string> Parameters::strings(std::string_view key) {
+  const ParameterDecl* d = declared(key, {ParameterType::Strings});
+  const toml::node* node = find(key);
+  if (!node) {
+    if (d && d->required) fail(key, "required (an array of strings)");
+    return {};
+  }
+  auto array = node->as_array();
+  if (!array) fail(key, fmt::format("expected an array of strings, got {}", type_name(*node)));
+  std::vector<std::string> values;
+  for (const auto& element : *array) {
+    auto value = element.as_string();
+    if (!value) fail(key, fmt::format("expected an array of strings, found {} in it", type_name(element)));
+    values.push_back(value->get());
+  }
+  return values;
+}
+
 const toml::table* Parameters::table(std::string_view key) {
+  declared(key, {ParameterType::Table});
   const toml::node* node = find(key);
   if (!node) return nullptr;
   auto t = node->as_table();
@@ -211,24 +489,87 @@ const toml::table* Parameters::table(std::string_view key) {
   return t;
 }
 
+Parameters& Parameters::section(std::string_view key) {
+  if (auto it = sections_.find(key); it != sections_.end()) return *it->second;
+  if (declarations_) {
+    const std::string prefix = prefix_ + std::string(key) + ".";
+    if (std::none_of(declarations_->begin(), declarations_->end(),
+                     [&](const ParameterDecl& d) { return d.key.starts_with(prefix); }))
+      throw std::logic_error(fmt::format("[{}] {}: read as a section, but no parameter is declared in it", section_, key));
+  }
+  const toml::node* node = find(key);
+  const toml::table* t = node ? node->as_table() : nullptr;
+  if (node && !t) fail(key, fmt::format("expected a table, got {}", type_name(*node)));
+  auto child = std::unique_ptr<Parameters>(new Parameters(t ? *t : empty_table(), declarations_,
+                                                          section_ + "." + std::string(key),
+                                                          prefix_ + std::string(key) + "."));
+  return *sections_.emplace(std::string(key), std::move(child)).first->second;
+}
+
 void Parameters::accept(std::string_view key) {
   if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.emplace_back(key);
 }
 
-void Parameters::accept(const std::vector<ParameterInfo>& infos) {
-  for (const auto& info : infos) accept(info.name);
+void Parameters::not_used(std::string_view key, std::string reason) {
+  const std::vector<std::string> keys = known_keys();
+  if (declarations_ && std::find(keys.begin(), keys.end(), key) == keys.end())
+    throw std::logic_error(fmt::format("[{}] {}: not_used() of a key that is not declared", section_, key));
+  not_used_[std::string(key)] = std::move(reason);
+}
+
+std::vector<std::string> Parameters::known_keys() const {
+  if (!declarations_) return known_;
+  std::vector<std::string> keys;
+  for (const ParameterDecl& d : *declarations_) {
+    if (!d.key.starts_with(prefix_)) continue;
+    std::string key = d.key.substr(prefix_.size());
+    key = key.substr(0, key.find('.'));
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+  }
+  return keys;
 }
 
 void Parameters::reject_unknown() const {
+  const std::vector<std::string> known = known_keys();
   for (const auto& [key, node] : table_) {
     if (std::find(known_.begin(), known_.end(), key.str()) != known_.end()) continue;
     std::string message = fmt::format("{}unknown key '{}' in [{}]", location_of(node), key.str(), section_);
-    if (auto near = closest_match(key.str(), known_); !near.empty())
+    if (auto near = closest_match(key.str(), known); !near.empty())
       message += fmt::format("; did you mean '{}'?", near);
-    else if (!known_.empty())
-      message += fmt::format(" (known keys: {})", fmt::join(known_, ", "));
+    else if (!known.empty())
+      message += fmt::format(" (known keys: {})", fmt::join(known, ", "));
     throw InputError(message);
   }
+}
+
+void Parameters::check_consumed() const {
+  const std::vector<std::string> known = known_keys();
+  for (const auto& [k, node] : table_) {
+    const std::string key(k.str());
+    if (std::find(known_.begin(), known_.end(), key) != known_.end()) {
+      if (auto it = sections_.find(key); it != sections_.end()) it->second->check_consumed();
+      continue;
+    }
+    if (std::find(known.begin(), known.end(), key) != known.end()) {  // declared, but not read
+      if (auto why = not_used_.find(key); why != not_used_.end())
+        throw InputError(fmt::format("{}[{}] {} is not used: {}", location_of(node), section_, key, why->second));
+      throw InputError(fmt::format("{}[{}] {} is set but not used with these settings (remove it)", location_of(node),
+                                   section_, key));
+    }
+    reject_unknown();  // the first unknown key, with a suggestion
+  }
+}
+
+std::vector<std::string> Parameters::consumed() const {
+  std::vector<std::string> keys;
+  for (const auto& key : known_) {
+    if (!table_.contains(key)) continue;
+    if (auto it = sections_.find(key); it != sections_.end())
+      for (const auto& inner : it->second->consumed()) keys.push_back(key + "." + inner);
+    else
+      keys.push_back(key);
+  }
+  return keys;
 }
 
 void Parameters::forbid(const std::vector<std::string>& keys, std::string_view reason) const {

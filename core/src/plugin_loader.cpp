@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <exception>
 #include <map>
+#include <optional>
 #include <set>
 #include <system_error>
 
@@ -150,7 +151,7 @@ LoadedModel load_plugin_file(const fs::path& file) {
   // The ABI first: nothing else of a plugin built against other headers may be trusted.
   auto abi_function = reinterpret_cast<AbiFunction>(require_symbol(guard.handle, file, "bodyfit_plugin_abi"));
   std::uint32_t abi = abi_function();
-  if ((abi >> 16) != kPluginAbiMajor || (abi & 0xffffu) > kPluginAbiMinor)
+  if (!abi_compatible(abi))
     throw file_error(file, fmt::format("built against plugin ABI {}, this bodyfit needs {}.x (up to {}): rebuild it "
                                        "against bodyfit {}",
                                        abi_string(abi), kPluginAbiMajor, abi_string(kPluginAbi), config::version));
@@ -201,9 +202,11 @@ LoadedModel load_model(std::string_view name) {
 
 void configure_model(LoadedModel& model, const toml::table& parameters, const SurfaceSource& surface) {
   const std::string where = model.file().string();
+  std::optional<Parameters> reader;
   try {
-    if ((model.abi() & 0xffffu) >= 4) model->set_surface(surface);
-    model->configure(parameters);
+    model->set_surface(surface);
+    reader.emplace(parameters, model->parameters(), "model");
+    model->configure(*reader);
   } catch (const InputError& e) {
     throw file_error(model.file(), fmt::format("configure failed: {}", e.what()));
   } catch (const std::exception& e) {
@@ -212,6 +215,7 @@ void configure_model(LoadedModel& model, const toml::table& parameters, const Su
     throw PluginError(fmt::format("{}: model '{}' failed in configure: an exception that is not a std::exception", where,
                                   model->name()));
   }
+  reader->check_consumed();  // the case's keys: a message of the case file, not of the plugin
 }
 
 std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
@@ -230,6 +234,7 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
         info.version = std::string(loaded->version());
         info.description = std::string(loaded->description());
         info.parameters = loaded->parameters();
+        info.outputs = loaded->outputs();
         found.emplace(name, std::move(info));
       } catch (const std::exception& e) {
         if (failures) failures->push_back(e.what());

@@ -32,25 +32,35 @@ double region_area(const bodyfit::StepContext& context) {
 class WindyModel final : public bodyfit::VelocityModel {
  public:
   std::string_view name() const override { return "windy"; }
-  std::string_view version() const override { return "2.0"; }
+  std::string_view version() const override { return "3.0"; }
   std::string_view description() const override {
     return "normal speed max(0, base + wind . n), H1-smoothed (example plugin)";
   }
-  std::vector<bodyfit::ParameterInfo> parameters() const override {
-    return {{"base", "1", "speed without wind (length/time, >= 0)"},
-            {"wind", "[1, 0, 0]", "wind vector (length/time)"},
-            {"smoothing", "0", "H1 smoothing length (length, >= 0; 0: none)"},
-            {"max_growth", "0", "reject a step growing |G| by more than this fraction (0: accept all)"}};
+  // Declared once: `bodyfit plugins --describe windy` prints them, configure() reads through them,
+  // and a key of [model] that configure() does not read is refused before the run starts.
+  std::vector<bodyfit::ParameterDecl> parameters() const override {
+    using bodyfit::ParameterDecl;
+    return {ParameterDecl::number("base", "length/time", "speed without wind").fallback(1.0).at_least(0),
+            ParameterDecl::numbers("wind", 3, "length/time", "wind vector").fallback(std::vector<double>{1, 0, 0}),
+            ParameterDecl::number("smoothing", "length", "H1 smoothing length (0: none)").fallback(0.0).at_least(0),
+            ParameterDecl::number("max_growth", "1", "reject a step growing |G| by more than this fraction (0: accept "
+                                                     "all)")
+                .fallback(0.0)
+                .at_least(0)};
+  }
+  std::vector<bodyfit::OutputDecl> outputs() const override {
+    using bodyfit::OutputDecl;
+    return {OutputDecl::metric("max_speed", "length/time", "the largest normal speed"),
+            OutputDecl::vertex_field("windy_speed", "length/time", "the normal speed"),
+            OutputDecl::vertex_field("wind", "length/time", "the wind (a vector)")};
   }
 
-  void configure(const toml::table& table) override {
-    bodyfit::Parameters p(table, "model");
-    base_ = p.number("base", 1.0, {.min = 0});
-    auto wind = p.numbers("wind", {1, 0, 0}, 3);
+  void configure(bodyfit::Parameters& p) override {
+    base_ = p.number("base");  // the declared default and range: "[model] base: -1 is out of range [0, inf)"
+    auto wind = p.numbers("wind");
     wind_ = bodyfit::Vec3(wind[0], wind[1], wind[2]);
-    smoothing_ = p.number("smoothing", 0.0, {.min = 0});
-    max_growth_ = p.number("max_growth", 0.0, {.min = 0});
-    p.reject_unknown();  // "unknown key 'wnid' in [model]; did you mean 'wind'?"
+    smoothing_ = p.number("smoothing");
+    max_growth_ = p.number("max_growth");
   }
 
   // Ask the driver to keep T^n (so it can restore it) only when this model may reject.

@@ -7,7 +7,7 @@
 // With `period` P > 0 the speed oscillates: V = speed·cos(2πt/P + phase)·∇_S d, so the front goes
 // out and back and a cap of polar angle a0 on the unit sphere has the exact polar angle
 //     a(t) = a0 + speed·P/(2π)·(sin(2πt/P + phase) − sin(phase)),
-// periodic in t (issue 14's drift test; bench/bench_drift, bench/bench_soak). The factor applied
+// periodic in t (the drift test; bench/bench_drift, bench/bench_soak). The factor applied
 // over a step [t, t + Δt] is the mean of cos over it, so that a step moves a front at uniform
 // speed by the exact distance whatever Δt (with CFL sub-steps: the mean over what remains of the
 // step).
@@ -28,18 +28,24 @@ class ConormalModel final : public bodyfit::VelocityModel {
   std::string_view description() const override {
     return "V = speed * grad_S d: the unit conormal extended by the gradient of the signed distance (paper (4.1))";
   }
-  std::vector<bodyfit::ParameterInfo> parameters() const override {
-    return {{"speed", "1", "factor multiplying V (length/time); a negative value shrinks G"},
-            {"period", "0", "period P of an oscillating speed speed*cos(2 pi t/P + phase) (time; 0: constant speed)"},
-            {"phase", "0", "phase of the oscillation (degrees; only with period)"}};
+  std::vector<bodyfit::ParameterDecl> parameters() const override {
+    using bodyfit::ParameterDecl;
+    return {ParameterDecl::number("speed", "length/time", "factor multiplying V; a negative value shrinks G").fallback(1.0),
+            ParameterDecl::number("period", "time", "period P of an oscillating speed speed·cos(2πt/P + phase); 0: a "
+                                                    "constant speed")
+                .fallback(0.0)
+                .at_least(0),
+            ParameterDecl::number("phase", "degrees", "phase of the oscillation (with a period)").fallback(0.0)};
   }
-  void configure(const toml::table& table) override {
-    bodyfit::Parameters p(table, "model");
-    speed_ = p.number("speed", 1.0);
-    period_ = p.number("period", 0.0, {.min = 0});
-    phase_ = p.number("phase", 0.0) * std::numbers::pi / 180;
-    if (period_ == 0 && p.has("phase")) p.fail("phase", "applies only with a period > 0");
-    p.reject_unknown();
+  std::vector<bodyfit::OutputDecl> outputs() const override {
+    return {bodyfit::OutputDecl::metric("speed", "length/time", "the factor of the step (speed × the mean of the "
+                                                                "oscillation over it)")};
+  }
+  void configure(bodyfit::Parameters& p) override {
+    speed_ = p.number("speed");
+    period_ = p.number("period");
+    if (period_ > 0) phase_ = p.number("phase") * std::numbers::pi / 180;
+    else p.not_used("phase", "it applies only with a period > 0");
   }
   bodyfit::VelocityField compute(const bodyfit::StepContext& context) override {
     const double factor = speed_ * oscillation(context.time(), context.dt());

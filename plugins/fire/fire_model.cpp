@@ -94,6 +94,22 @@ std::vector<Perimeter> load_perimeters(const ModelState& state) {
   return perimeters;
 }
 
+/// A raster of the model as a grid output, in its coordinate system.
+GridField grid_field(const HeightGrid& grid, std::string description,
+                     std::vector<std::pair<std::string, std::string>> items, const std::string& crs) {
+  GridField field;
+  field.cols = grid.cols, field.rows = grid.rows;
+  field.x_origin = grid.x_origin, field.y_origin = grid.y_origin;
+  field.cell_size = grid.cell_size;
+  field.values = grid.heights;
+  for (double& v : field.values)
+    if (v == grid.nodata) v = std::numeric_limits<double>::quiet_NaN();
+  field.crs = crs;
+  field.description = std::move(description);
+  field.items = std::move(items);
+  return field;
+}
+
 class FireModel final : public VelocityModel {
  public:
   std::string_view name() const override { return "fire"; }
@@ -103,80 +119,104 @@ class FireModel final : public VelocityModel {
            "SI units: metres, seconds";
   }
 
-  std::vector<ParameterInfo> parameters() const override {
+  std::vector<ParameterDecl> parameters() const override {
+    std::vector<ParameterDecl> declared = {
+        ParameterDecl::choice("preset", {"balbi2009", "paper_table1"},
+                              "fuel parameter set: balbi2009 (R0 0.398 m/s, A 1.873) or paper_table1 (R0 2.7 m/s, A 1.25)")
+            .fallback("balbi2009"),
+        ParameterDecl::number("R0", "m/s", "rate of spread without slope and wind").computed("the preset's").positive(),
+        ParameterDecl::number("A", "1", "radiant / ignition energy ratio").computed("the preset's").positive(),
+        ParameterDecl::number("u0", "m/s", "combustion gas velocity").fallback(39.8).positive(),
+        ParameterDecl::number("v0", "m/s", "flame-base velocity").computed("12·R0").positive(),
+        ParameterDecl::number("max_tilt_deg", "degrees", "cap on the tilt angle γ (< 90)")
+            .fallback(80.0)
+            .within({.min = 0, .max = 90, .min_exclusive = true, .max_exclusive = true}),
+        ParameterDecl::choice("front_velocity", {"huygens", "normal"},
+                              "huygens: V = R n_Σ + (dR/dθ) t, along the front's characteristics (Huygens' "
+                              "principle); normal: V = R n_Σ as in the paper. The same front as the steps shrink; "
+                              "huygens is closer at a given step")
+            .fallback("huygens"),
+        ParameterDecl::choice("slope", {"surface", "mesh"},
+                              "surface: the slope from the input surface's smooth normal, one field whatever the "
+                              "mesh; mesh: from the current mesh's vertex normals, which change with every remesh")
+            .fallback("surface"),
+        ParameterDecl::path("fuel.map", "raster of fuel codes: k ≥ 1 = fuel.presets[k−1]; 0, NODATA and "
+                                        "fuel.non_burnable do not burn"),
+        ParameterDecl::strings("fuel.presets", "parameter sets of the codes of fuel.map (default: [preset])"),
+        ParameterDecl::numbers("fuel.non_burnable", 0, "", "more codes of fuel.map that do not burn (water, rock, e.g. "
+                                                            "[98, 99])")
+            .fallback(std::vector<double>{}),
+        ParameterDecl::number("arrival.cell_size", "m", "cell size of the arrival-time grid")
+            .computed("the mean edge length")
+            .at_least(0),
+        ParameterDecl::path("arrival.like", "a raster (e.g. the DEM) whose cells the arrival-time grid uses"),
+        ParameterDecl::string("perimeters.file", "the burnt region's outline at every perimeters.every-th state and "
+                                                 "the last (.gpkg or .geojson; \"\": none)")
+            .fallback(config::have_gdal ? "perimeters.gpkg" : ""),
+        ParameterDecl::integer("perimeters.every", "iterations", "a perimeter every this many iterations")
+            .fallback(1)
+            .at_least(1),
+        ParameterDecl::path("barriers.file", "roads, rivers, fuel breaks, lakes: lines and polygons of a vector layer "
+                                             "(GeoJSON, Shapefile, GeoPackage) where R = 0 within max(width/2, 2 × the "
+                                             "longest edge)")
+            .require(),
+        ParameterDecl::string("barriers.layer", "the layer of barriers.file").computed("the first"),
+        ParameterDecl::number("barriers.width", "m", "width of the barriers (narrower than the mesh: they act with its "
+                                                     "width)")
+            .fallback(0.0)
+            .at_least(0),
+    };
+    for (ParameterDecl& d : wind_parameters()) declared.push_back(std::move(d));
+    return declared;
+  }
+
+  std::vector<OutputDecl> outputs() const override {
     return {
-        {"preset", "\"balbi2009\"", "fuel parameter set: balbi2009 (R0 0.398 m/s, A 1.873) or paper_table1 (R0 2.7 m/s, A 1.25)"},
-        {"R0", "(preset)", "rate of spread without slope and wind, m/s"},
-        {"A", "(preset)", "radiant / ignition energy ratio, dimensionless"},
-        {"u0", "39.8", "combustion gas velocity, m/s"},
-        {"v0", "12*R0", "flame-base velocity, m/s"},
-        {"max_tilt_deg", "80", "cap on the tilt angle γ, degrees (< 90)"},
-        {"front_velocity", "\"huygens\"", "huygens: V = R n_Σ + (dR/dθ) t, along the front's characteristics "
-                                          "(Huygens' principle); normal: V = R n_Σ as in the paper. The same front "
-                                          "as the steps shrink; huygens is closer at a given step"},
-        {"slope", "\"surface\"", "surface: the slope from the input surface's smooth normal, one field whatever the "
-                                   "mesh; mesh: from the current mesh's vertex normals, which change with every "
-                                   "remesh"},
-        {"wind.type", "\"none\"", "none | uniform | rotating | grid | series | grid_series"},
-        {"wind.velocity", "[0, 0]", "uniform wind (x, y), m/s"},
-        {"wind.speed, wind.direction_deg", "", "uniform wind as speed (m/s) and the direction it blows from (degrees "
-                                               "clockwise from north), instead of velocity"},
-        {"wind.center", "(domain centre)", "rotating wind centre (x, y), m: U = scale·(y − yc, −(x − xc), 0)"},
-        {"wind.scale", "0.001", "rotating wind angular rate, 1/s (m/s of wind per m from the centre)"},
-        {"wind.u_file, wind.v_file", "", "gridded wind components, ESRI ASCII grids (m/s)"},
-        {"wind.file", "", "series: CSV time,speed,direction_deg or time,u,v; grid_series: CSV time,u_file,v_file "
-                          "(rasters relative to it); times in s after t = 0 or ISO 8601 ([time] start); linear "
-                          "in time on (u, v), the end values held outside"},
-        {"fuel.map", "", "raster of fuel codes: k ≥ 1 = fuel.presets[k−1]; 0, NODATA and fuel.non_burnable do not burn"},
-        {"fuel.presets", "[preset]", "parameter sets of the codes of fuel.map"},
-        {"fuel.non_burnable", "[]", "more codes of fuel.map that do not burn (water, rock, e.g. [98, 99])"},
-        {"arrival.cell_size", "(mean edge length)", "cell size of the arrival-time raster, m"},
-        {"arrival.like", "", "an ESRI ASCII grid (e.g. the DEM) whose raster the arrival times use"},
-        {"arrival.format", "\"tif\"", "tif (GeoTIFF with CRS, NODATA, units) | asc (ESRI ASCII grid + .prj): "
-                                      "arrival_time.<format> (s) and rate_of_spread.<format> (m/s)"},
-        {"perimeters.file", "\"perimeters.gpkg\"", "the burnt region's outline at every perimeters.every-th state "
-                                                   "and the last (.gpkg or .geojson; \"\": none)"},
-        {"perimeters.every", "1", "a perimeter every this many iterations"},
-        {"barriers.file", "", "roads, rivers, fuel breaks, lakes: lines and polygons of a vector layer (GeoJSON, "
-                              "Shapefile, GeoPackage) where R = 0 within max(width/2, 2 × the longest edge)"},
-        {"barriers.layer", "(the first)", "the layer of barriers.file"},
-        {"barriers.width", "0", "width of the barriers, m (narrower than the mesh: they act with its width)"},
+        OutputDecl::vertex_field("rate_of_spread", "m/s", "R at the vertices (through the extended front normal)"),
+        OutputDecl::vertex_field("arrival_time", "s", "the arrival-time grid sampled at the vertices (terrains)"),
+        OutputDecl::metric("ros_min", "m/s", "smallest R on the front"),
+        OutputDecl::metric("ros_mean", "m/s", "mean R on the front"),
+        OutputDecl::metric("ros_max", "m/s", "largest R on the front"),
+        OutputDecl::metric("ros_all_mean", "m/s", "mean R over the whole surface"),
+        OutputDecl::metric("ros_all_max", "m/s", "largest R over the whole surface"),
+        OutputDecl::grid("arrival_time", "s", "the time the front reached each cell (terrains)")
+            .combine(Combine::share("burn_probability", "burn probability over {members} members"))
+            .combine(Combine::mean("arrival_mean", "s", "mean arrival time over the members that reached the cell"))
+            .combine(Combine::percentiles("arrival_p", "s", "arrival time, percentile {percentile} over the members "
+                                                            "that reached the cell"))
+            .combine(Combine::front_speed("ros_mean", "m/s", "conditional rate of spread (1/|grad t|), mean over the "
+                                                             "members")),
+        OutputDecl::grid("rate_of_spread", "m/s", "the rate of spread at which each cell burnt (terrains)"),
+        OutputDecl::value("burnt_area", "m²", "|G| at the end: the area burnt, on the surface"),
+        OutputDecl::file("perimeters.gpkg", "the burnt region's outline (perimeters.file)"),
+        OutputDecl::file("perimeters.geojson", "the same as GeoJSON (perimeters.file)"),
+        OutputDecl::file("fire_map.png", "the run's map: hillshade, burnt area, isochrones"),
     };
   }
 
   void set_surface(const SurfaceSource& source) override { surface_ = source; }
 
-  void configure(const toml::table& table) override {
-    Parameters p(table, "model");
-    p.accept("name");
-    const std::string preset_name = p.choice("preset", "balbi2009", {"balbi2009", "paper_table1"});
+  void configure(Parameters& p) override {
+    const std::string preset_name = p.choice("preset");
     base_ = preset(preset_name);
-    base_.R0 = p.number("R0", base_.R0, {.min = 0, .min_exclusive = true});
-    base_.A = p.number("A", base_.A, {.min = 0, .min_exclusive = true});
-    base_.u0 = p.number("u0", base_.u0, {.min = 0, .min_exclusive = true});
-    base_.v0 = p.number("v0", 12 * base_.R0, {.min = 0, .min_exclusive = true});
-    base_.max_tilt = p.number("max_tilt_deg", 80, {.min = 0, .max = 90, .min_exclusive = true, .max_exclusive = true}) * kDegree;
-    huygens_ = p.choice("front_velocity", "huygens", {"huygens", "normal"}) == "huygens";
-    surface_slope_ = p.choice("slope", "surface", {"surface", "mesh"}) == "surface";
+    base_.u0 = p.number("u0");
+    base_.max_tilt = p.number("max_tilt_deg") * kDegree;
+    huygens_ = p.choice("front_velocity") == "huygens";
+    surface_slope_ = p.choice("slope") == "surface";
 
-    if (const toml::table* wind = p.table("wind"))
-      wind_ = read_wind_table(*wind, [&](const std::filesystem::path& file) {
+    if (p.has("wind"))
+      wind_ = read_wind_table(p.section("wind"), [&](const std::filesystem::path& file) {
         return read_model_raster(file, Resampling::bilinear);
       });
-    if (const toml::table* fuel = p.table("fuel")) {
-      Parameters f(*fuel, "model.fuel");
+    fuels_.clear();
+    if (p.has("fuel")) {
+      // Each fuel class is a preset: R0, A and v0 come from it, not from [model].
+      for (const char* key : {"R0", "A", "v0"})
+        p.not_used(key, fmt::format("{} is set per fuel class by [model.fuel] presets; give it in the fuel table", key));
+      Parameters& f = p.section("fuel");
       const std::filesystem::path map = f.path("map");
-      std::vector<std::string> names;
-      if (auto* arr = (*fuel)["presets"].as_array()) {
-        f.accept("presets");
-        for (auto& node : *arr) {
-          auto s = node.value<std::string>();
-          if (!s) throw InputError("[model.fuel] presets: expected an array of preset names");
-          names.push_back(*s);
-        }
-      }
+      std::vector<std::string> names = f.strings("presets");
       if (names.empty()) names.push_back(preset_name);
-      fuels_.clear();
       for (auto& n : names) {
         try {
           BalbiParameters q = preset(n);
@@ -184,13 +224,13 @@ class FireModel final : public VelocityModel {
           q.u0 = base_.u0;
           fuels_.push_back(q);
         } catch (const std::invalid_argument& e) {
-          throw InputError(std::string("[model.fuel] presets: ") + e.what());
+          f.fail("presets", e.what());
         }
       }
       non_burnable_.clear();
-      for (double code : f.numbers("non_burnable", {}, std::nullopt)) {
+      for (double code : f.numbers("non_burnable")) {
         if (code != std::round(code) || std::abs(code) > 1e15)
-          throw InputError(fmt::format("[model.fuel] non_burnable: {} is not an integer fuel code", code));
+          f.fail("non_burnable", fmt::format("{} is not an integer fuel code", code));
         non_burnable_.push_back(std::llround(code));
       }
       fuel_file_ = map;
@@ -198,31 +238,30 @@ class FireModel final : public VelocityModel {
         fuel_map_ = read_model_raster(map, Resampling::nearest);
         check_fuel_codes();
       }
-      f.reject_unknown();
+    } else {
+      base_.R0 = p.number("R0", base_.R0);
+      base_.A = p.number("A", base_.A);
+      base_.v0 = p.number("v0", 12 * base_.R0);
     }
-    if (const toml::table* arrival = p.table("arrival")) {
-      Parameters a(*arrival, "model.arrival");
-      arrival_cell_ = a.number("cell_size", 0, {.min = 0});
+    if (p.has("arrival")) {
+      Parameters& a = p.section("arrival");
+      arrival_cell_ = a.number("cell_size", 0);
       const std::filesystem::path like = a.path("like");
       arrival_like_file_ = like;
       if (!like.empty()) arrival_like_ = read_model_raster(like, Resampling::bilinear);
-      arrival_format_ = a.choice("format", arrival_format_, {"tif", "asc"});
-      a.reject_unknown();
     }
-    if (const toml::table* perimeters = p.table("perimeters")) {
-      Parameters q(*perimeters, "model.perimeters");
-      perimeter_file_ = q.string("file", perimeter_file_);
-      perimeter_every_ = int(q.integer("every", perimeter_every_, 1));
-      q.reject_unknown();
+    if (p.has("perimeters")) {
+      Parameters& q = p.section("perimeters");
+      perimeter_file_ = q.string("file");
+      perimeter_every_ = int(q.integer("every"));
     }
-    if (const toml::table* barriers = p.table("barriers")) {
-      Parameters b(*barriers, "model.barriers");
+    if (p.has("barriers")) {
+      Parameters& b = p.section("barriers");
       BarrierOptions options;
       options.file = b.path("file");
       options.layer = b.string("layer", "");
-      options.width = b.number("width", 0, {.min = 0});
-      b.reject_unknown();
-      if (options.file.empty()) throw InputError("[model.barriers] file: expected a vector layer of barriers");
+      options.width = b.number("width");
+      if (options.file.empty()) b.fail("file", "expected a vector layer of barriers");
       barriers_ = Barriers::read(options, surface_);
     } else {
       barriers_ = Barriers();
@@ -245,7 +284,6 @@ class FireModel final : public VelocityModel {
         if (crs_.empty()) crs_ = grid->crs;
       }
     }
-    p.reject_unknown();
   }
 
   VelocityField compute(const StepContext& context) override {
@@ -392,31 +430,26 @@ class FireModel final : public VelocityModel {
     }
   }
 
-  void finish(const std::filesystem::path& output_dir) override {
-    if (output_dir.empty()) return;
+  void finish(const StepContext& final_state, ModelOutputs& outputs) override {
+    const std::filesystem::path& output_dir = final_state.output_dir();
+    outputs.value("burnt_area", region_area(final_state.mesh(), kInside));
     if (arrival_.initialised()) {
       const std::string since = clock_start_ ? "after " + format_iso8601(*clock_start_) : "after the start (t = 0)";
       std::vector<std::pair<std::string, std::string>> items;
       if (clock_start_) items.emplace_back("START_TIME", format_iso8601(*clock_start_));
-      HeightGrid arrival = arrival_.grid();
-      arrival.crs = crs_;
-      write_raster(output_dir / ("arrival_time." + arrival_format_), arrival,
-                   {.units = "s", .description = "fire arrival time, seconds " + since, .items = items});
-      HeightGrid rate = arrival_.rate_grid();
-      rate.crs = crs_;
-      write_raster(output_dir / ("rate_of_spread." + arrival_format_), rate,
-                   {.units = "m/s",
-                    .description = "rate of spread (Balbi) at which the cell burnt, m/s (NODATA: not reached, or "
-                                   "burning at the start)",
-                    .items = items});
+      outputs.grid("arrival_time", grid_field(arrival_.grid(), "fire arrival time, seconds " + since, items, crs_));
+      outputs.grid("rate_of_spread",
+                   grid_field(arrival_.rate_grid(),
+                              "rate of spread (Balbi) at which the cell burnt, m/s (NODATA: not reached, or burning at "
+                              "the start)",
+                              items, crs_));
     }
+    if (output_dir.empty()) return;
     write_perimeters(output_dir);
     // The run's map (docs/fire.md, "Maps"), drawn from the files just written. A map that cannot be
     // drawn (no Cairo) costs the run nothing: its results are all written.
     // Only after `bodyfit run`, which writes final.mesh first; not when a program calls evolve().
-    if (!arrival_.initialised() || output_dir.empty() || !config::have_cairo ||
-        !std::filesystem::exists(output_dir / "final.mesh"))
-      return;
+    if (!arrival_.initialised() || !config::have_cairo || !std::filesystem::exists(output_dir / "final.mesh")) return;
     try {
       RunMap run = load_run_map(output_dir);
       draw_fire_map(output_dir / "fire_map.png", run.mesh, run.layers, {.title = "Fire map: burnt area and arrival time"});
@@ -426,9 +459,7 @@ class FireModel final : public VelocityModel {
   }
 
   std::vector<std::string> output_files() const override {
-    std::vector<std::string> files = {"arrival_time.tif", "arrival_time.asc", "arrival_time.prj",
-                                      "rate_of_spread.tif", "rate_of_spread.asc", "rate_of_spread.prj",
-                                      "perimeters.gpkg",  "perimeters.geojson", "fire_map.png"};
+    std::vector<std::string> files = declared_output_files(outputs());
     if (!perimeter_file_.empty() && std::find(files.begin(), files.end(), perimeter_file_) == files.end())
       files.push_back(perimeter_file_);
     return files;
@@ -439,7 +470,7 @@ class FireModel final : public VelocityModel {
   // state); kept when it is a perimeters.every-th state, and always as the latest (the final state
   // is the last one computed: finish() adds it).
   void record_perimeter(const StepContext& context) {
-    if (perimeter_file_.empty()) return;
+    if (perimeter_file_.empty() || context.output_dir().empty()) return;
     const int iteration = context.iteration();
     if (!perimeters_.empty() && perimeters_.back().iteration >= iteration) return;
     if (latest_ && latest_->iteration == iteration) return;
@@ -545,7 +576,6 @@ class FireModel final : public VelocityModel {
   bool huygens_ = true;  ///< front_velocity: V = R n + (dR/dθ) t (true) or R n (the paper's)
   bool surface_slope_ = true;  ///< slope: from S's smooth normal (true) or T^n's vertex normals
   ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
-  std::string arrival_format_ = config::have_gdal ? "tif" : "asc";
   std::string perimeter_file_ = config::have_gdal ? "perimeters.gpkg" : "";
   int perimeter_every_ = 1;
   std::vector<Perimeter> perimeters_;

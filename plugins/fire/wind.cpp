@@ -263,24 +263,56 @@ std::vector<std::pair<const HeightGrid*, std::filesystem::path>> WindField::rast
   return list;
 }
 
-WindField read_wind_table(const toml::table& table, const RasterReader& read) {
-  Parameters w(table, "model.wind");
+std::vector<ParameterDecl> wind_parameters() {
+  return {
+      ParameterDecl::choice("wind.type", {"none", "uniform", "rotating", "grid", "series", "grid_series"},
+                            "the wind: none, uniform, rotating about a centre, gridded, a series in time, gridded in time")
+          .fallback("none"),
+      ParameterDecl::numbers("wind.velocity", 2, "m/s", "uniform: the wind (x, y)").fallback(std::vector<double>{0, 0}),
+      ParameterDecl::number("wind.speed", "m/s", "uniform: the wind's speed, instead of velocity").at_least(0),
+      ParameterDecl::number("wind.direction_deg", "degrees",
+                            "uniform, with speed: the direction it blows from, clockwise from north"),
+      ParameterDecl::numbers("wind.center", 2, "m", "rotating: the centre (x, y): U = scale·(y − yc, −(x − xc), 0)")
+          .computed("the centre of the domain"),
+      ParameterDecl::number("wind.scale", "1/s", "rotating: the angular rate (m/s of wind per m from the centre)")
+          .fallback(1e-3),
+      ParameterDecl::path("wind.u_file", "grid: the x component, an ESRI ASCII grid or GeoTIFF (m/s)"),
+      ParameterDecl::path("wind.v_file", "grid: the y component (m/s)"),
+      ParameterDecl::path("wind.file", "series: CSV time,speed,direction_deg or time,u,v; grid_series: CSV "
+                                       "time,u_file,v_file (rasters relative to it); times in s after t = 0 or ISO "
+                                       "8601 ([time] start); linear in time on (u, v), the end values held outside"),
+  };
+}
+
+WindField read_wind_table(Parameters& w, const RasterReader& read) {
   WindField wind;
-  wind.type = w.choice("type", "none", {"none", "uniform", "rotating", "grid", "series", "grid_series"});
-  auto velocity = w.numbers("velocity", {0, 0}, 2);
-  wind.uniform = Vec3(velocity[0], velocity[1], 0);
-  // Or as a weather report gives it (what an ensemble samples).
-  if (w.has("speed") || w.has("direction_deg")) {
-    if (wind.type != "uniform") w.fail("speed", "speed and direction_deg apply to type = \"uniform\"");
-    if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
-    const double speed = w.required_number("speed", {.min = 0});
-    wind.uniform = wind_from_direction(speed, w.required_number("direction_deg"));
+  wind.type = w.choice("type");
+  const auto applies_to = [&](const char* key, const char* types) {
+    w.not_used(key, fmt::format("it applies to type = {} (the wind is type = \"{}\")", types, wind.type));
+  };
+  if (wind.type == "uniform") {
+    // As a velocity, or as a weather report gives it (what an ensemble samples).
+    if (w.has("speed") || w.has("direction_deg")) {
+      if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
+      const double speed = w.required_number("speed");
+      wind.uniform = wind_from_direction(speed, w.required_number("direction_deg"));
+    } else {
+      const auto velocity = w.numbers("velocity");
+      wind.uniform = Vec3(velocity[0], velocity[1], 0);
+    }
+  } else {
+    for (const char* key : {"velocity", "speed", "direction_deg"}) applies_to(key, "\"uniform\"");
   }
-  auto center = w.numbers("center", {}, std::nullopt);
-  if (!center.empty() && center.size() != 2) throw InputError("[model.wind] center: expected [x, y]");
-  wind.has_center = !center.empty();
-  if (wind.has_center) wind.center = Vec3(center[0], center[1], 0);
-  wind.scale = w.number("scale", 1e-3);
+  if (wind.type == "rotating") {
+    if (w.has("center")) {
+      const auto center = w.numbers("center", {});
+      wind.has_center = true;
+      wind.center = Vec3(center[0], center[1], 0);
+    }
+    wind.scale = w.number("scale");
+  } else {
+    for (const char* key : {"center", "scale"}) applies_to(key, "\"rotating\"");
+  }
   if (wind.type == "grid") {
     if (!w.has("u_file") || !w.has("v_file"))
       throw InputError("[model.wind] type = \"grid\" needs u_file and v_file (ESRI ASCII grids)");
@@ -289,8 +321,7 @@ WindField read_wind_table(const toml::table& table, const RasterReader& read) {
     wind.u = read_wind_raster(wind.u_file, read);
     wind.v = read_wind_raster(wind.v_file, read);
   } else {
-    w.accept("u_file");
-    w.accept("v_file");
+    for (const char* key : {"u_file", "v_file"}) applies_to(key, "\"grid\"");
   }
   if (wind.type == "series" || wind.type == "grid_series") {
     if (!w.has("file"))
@@ -300,10 +331,8 @@ WindField read_wind_table(const toml::table& table, const RasterReader& read) {
     wind.series = wind.type == "series" ? read_wind_series(file) : read_wind_grid_series(file, read);
     if (!wind.series.clock_times) wind.set_clock(std::nullopt);
   } else {
-    w.forbid({"file"}, fmt::format("to type \"{}\" (a wind series is type = \"series\" or \"grid_series\")", wind.type));
-    w.accept("file");
+    applies_to("file", "\"series\" or \"grid_series\"");
   }
-  w.reject_unknown();
   return wind;
 }
 

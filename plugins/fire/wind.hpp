@@ -4,6 +4,7 @@
 // time on the components u, v; the end values held before the first time and after the last).
 #include <bodyfit/app/terrain.hpp>
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/parameters.hpp>
 
 #include <toml++/toml.h>
 
@@ -72,7 +73,10 @@ struct WindField {
   bool on_clock_ = false;
 };
 
-/// The [model.wind] table (docs/fire.md): the type and its keys, files relative to the case.
-WindField read_wind_table(const toml::table& table, const RasterReader& read = {});
+/// The declarations of [model.wind] (keys "wind.<key>").
+std::vector<ParameterDecl> wind_parameters();
+/// The [model.wind] table (docs/fire.md) read through wind_parameters(): the type and the keys it
+/// uses (the others are refused when set), files relative to the case.
+WindField read_wind_table(Parameters& wind, const RasterReader& read = {});
 
 }  // namespace bodyfit::fire

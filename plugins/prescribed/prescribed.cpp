@@ -39,23 +39,32 @@ class PrescribedModel final : public bodyfit::VelocityModel {
   std::string_view description() const override {
     return "a velocity given by a formula: the deformational flows of Nair & Lauritzen (2010) on the sphere";
   }
-  std::vector<bodyfit::ParameterInfo> parameters() const override {
-    return {{"flow", "\"nair_lauritzen\"", "the formula (only \"nair_lauritzen\" so far)"},
-            {"case", "4", "Nair & Lauritzen's case: 1, 2, 4 (non-divergent) or 3 (divergent)"},
-            {"period", "5", "T: the flow reverses at T/2 and is back at the start at T (time)"},
-            {"k", "", "deformation strength (default 2.4 for cases 1 and 4, 2 for case 2, 1 for case 3)"},
-            {"form", "\"vector\"", "\"vector\": V = u; \"normal\": the normal speed u . n_Sigma"}};
+  std::vector<bodyfit::ParameterDecl> parameters() const override {
+    using bodyfit::ParameterDecl;
+    return {ParameterDecl::choice("flow", {"nair_lauritzen"}, "the formula").fallback("nair_lauritzen"),
+            ParameterDecl::integer("case", "", "Nair & Lauritzen's case: 1, 2, 4 (non-divergent) or 3 (divergent)")
+                .fallback(4)
+                .within({.min = 1, .max = 4}),
+            ParameterDecl::number("period", "time", "T: the flow reverses at T/2 and is back at the start at T")
+                .fallback(5.0)
+                .positive(),
+            ParameterDecl::number("k", "", "deformation strength").computed("2.4 for cases 1 and 4, 2 for case 2, 1 for case 3"),
+            ParameterDecl::choice("form", {"vector", "normal"}, "vector: V = u; normal: the normal speed u·n_Σ")
+                .fallback("vector")};
   }
 
-  void configure(const toml::table& table) override {
-    bodyfit::Parameters p(table, "model");
-    p.choice("flow", "nair_lauritzen", {"nair_lauritzen"});
-    case_ = int(p.integer("case", 4, 1, 4));
-    period_ = p.number("period", 5.0, {.min = 0, .min_exclusive = true});
+  std::vector<bodyfit::OutputDecl> outputs() const override {
+    return {bodyfit::OutputDecl::metric("time_factor", "1", "cos(πt/T) at the middle of the step: the flow's reversal"),
+            bodyfit::OutputDecl::vertex_field("flow", "length/time", "the prescribed velocity u (a vector)")};
+  }
+
+  void configure(bodyfit::Parameters& p) override {
+    p.choice("flow");
+    case_ = int(p.integer("case"));
+    period_ = p.number("period");
     const double default_k = case_ == 2 ? 2.0 : case_ == 3 ? 1.0 : 2.4;
     k_ = p.number("k", default_k);
-    normal_form_ = p.choice("form", "vector", {"vector", "normal"}) == "normal";
-    p.reject_unknown();
+    normal_form_ = p.choice("form") == "normal";
   }
 
   bodyfit::VelocityField compute(const bodyfit::StepContext& context) override {

@@ -28,15 +28,13 @@ bool BoxField::inside_any(const Vec3& x) const {
   return false;
 }
 
-BoxField read_box_field(Parameters& p, const toml::table& table, const std::string& key, double fallback,
-                        Range range) {
+BoxField read_box_field(Parameters& p, const std::string& key) {
   BoxField field;
-  field.value = fallback;
-  const toml::node* node = table.get(key);
-  if (node && node->is_table()) {
-    Parameters t(*p.table(key), p.section() + "." + key);
-    field.value = t.number("value", fallback, range);
-    for (const auto& box : t.number_arrays("boxes", 7)) {
+  if (p.is_table(key)) {
+    Parameters& t = p.section(key);
+    field.value = t.number("value");
+    const Range range = t.declaration("value")->range;
+    for (const auto& box : t.points("boxes")) {
       std::array<double, 7> b{};
       std::copy(box.begin(), box.end(), b.begin());
       for (int k = 0; k < 3; ++k)
@@ -45,9 +43,8 @@ BoxField read_box_field(Parameters& p, const toml::table& table, const std::stri
       if (!range.contains(b[6])) t.fail("boxes", fmt::format("value {} is out of range {}", b[6], range.describe()));
       field.boxes.push_back(b);
     }
-    t.reject_unknown();
   } else {
-    field.value = p.number(key, fallback, range);
+    field.value = p.number(key);
   }
   return field;
 }

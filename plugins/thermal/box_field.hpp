@@ -26,9 +26,9 @@ struct BoxField {
   bool inside_any(const Vec3& x) const;
 };
 
-/// Read `key` of `table` through `p` (its Parameters): a number, or a table with `value` and
-/// `boxes`; `fallback` when absent. `range` applies to every value.
-BoxField read_box_field(Parameters& p, const toml::table& table, const std::string& key, double fallback,
-                        Range range = {});
+/// Read `key` through `p`: a number, or a table with `value` and `boxes` (declared as key,
+/// key.value and key.boxes); the declared default when absent. The declared range of key.value
+/// applies to the boxes' values too.
+BoxField read_box_field(Parameters& p, const std::string& key);
 
 }  // namespace bodyfit::thermal

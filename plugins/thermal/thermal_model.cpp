@@ -59,62 +59,107 @@ class ThermalModel final : public VelocityModel {
            "J = mean temperature + ell*|G| (paper §4.4; TetGen + P1 FEM + CHOLMOD)";
   }
 
-  std::vector<ParameterInfo> parameters() const override {
+  std::vector<ParameterDecl> parameters() const override {
+    const Range positive{.min = 0, .min_exclusive = true};
     return {
-        {"ell", "0.01", "weight ℓ of the area |G| in J (temperature / area)"},
-        {"epsilon", "3 h", "half-width ε of the smoothed Dirichlet band (length; default 3 × the mean edge of T^0)"},
-        {"alpha", "2", "H¹ regularisation length of the velocity, in mean edges h"},
-        {"conductivity", "1", "γ > 0: a number, or a table {value, boxes = [[xmin,ymin,zmin,xmax,ymax,zmax,γ], ...]}"},
-        {"source", "1", "heat source f: a number, or a table like conductivity"},
-        {"neumann.boxes", "[]", "Γ_N: surface faces whose centroid is in a box [xmin,ymin,zmin,xmax,ymax,zmax,g]; G may not go there"},
-        {"neumann.flux", "0", "heat flux g on Γ_N where no box value applies"},
-        {"radius_edge", "1.2", "TetGen quality bound -q (radius-edge ratio)"},
-        {"volume_factor", "0", "TetGen volume bound -a as a multiple of the regular tetrahedron of edge h (0: none)"},
-        {"solver", "\"conjugate_gradient\"", "conjugate_gradient (IC-preconditioned; falls back to CHOLMOD) | cholmod_supernodal | cholmod_simplicial | eigen_simplicial"},
-        {"armijo", "1e-4", "sufficient decrease: J(new) ≤ J + armijo·Δt·J′(v) + noise·|J|, else the step is rejected"},
-        {"noise", "0.01", "relative increase of J tolerated for the remeshing and tetrahedralisation noise of the discrete J"},
-        {"min_step_factor", "0.0625", "a step shorter than this × the case's Δt that still raises J is taken anyway (a jump of the discretisation, not an ascent)"},
-        {"grow", "1.2", "Δt is multiplied by this after an accepted step"},
-        {"max_dt_factor", "4", "cap on Δt, as a multiple of the case's Δt"},
-        {"tolerance", "1e-3", "converged when the best J improves by less than this (relative) ..."},
-        {"patience", "15", "... over this many accepted steps"},
-        {"volume_every", "0", "write volume_NNNNN.vtu (tetrahedra with u) every k states (0: never)"},
+        ParameterDecl::number("ell", "temperature/area", "weight ℓ of the area |G| in J").fallback(0.01).at_least(0),
+        ParameterDecl::number("epsilon", "length", "half-width ε of the smoothed Dirichlet band")
+            .computed("3 × the mean edge of T^0")
+            .positive(),
+        ParameterDecl::number("alpha", "h", "H¹ regularisation length of the velocity, in mean edges h").fallback(2.0).at_least(0),
+        ParameterDecl::number("conductivity", "", "γ > 0, or a table {value, boxes}").fallback(1.0).within(positive),
+        ParameterDecl::number("conductivity.value", "", "γ outside the boxes").fallback(1.0).within(positive),
+        ParameterDecl::points("conductivity.boxes", 7, "", "[xmin, ymin, zmin, xmax, ymax, zmax, γ]: γ inside each box"),
+        ParameterDecl::number("source", "", "heat source f, or a table {value, boxes}").fallback(1.0),
+        ParameterDecl::number("source.value", "", "f outside the boxes").fallback(1.0),
+        ParameterDecl::points("source.boxes", 7, "", "[xmin, ymin, zmin, xmax, ymax, zmax, f]: f inside each box"),
+        ParameterDecl::points("neumann.boxes", 7, "",
+                              "Γ_N: surface faces whose centroid is in a box [xmin, ymin, zmin, xmax, ymax, zmax, g]; G "
+                              "may not go there"),
+        ParameterDecl::number("neumann.flux", "", "heat flux g on Γ_N where no box value applies").fallback(0.0),
+        ParameterDecl::number("radius_edge", "1", "TetGen quality bound -q (radius-edge ratio)").fallback(1.2).at_least(1),
+        ParameterDecl::number("volume_factor", "1", "TetGen volume bound -a as a multiple of the regular tetrahedron of "
+                                                    "edge h (0: none)")
+            .fallback(0.0)
+            .at_least(0),
+        ParameterDecl::choice("solver", {"conjugate_gradient", "cholmod_supernodal", "cholmod_simplicial", "eigen_simplicial"},
+                              "conjugate_gradient (IC-preconditioned; falls back to CHOLMOD) or a direct solver")
+            .fallback("conjugate_gradient"),
+        ParameterDecl::number("armijo", "1", "sufficient decrease: J(new) ≤ J + armijo·Δt·J′(v) + noise·|J|, else the step "
+                                             "is rejected")
+            .fallback(1e-4)
+            .within({.min = 0, .max = 1, .max_exclusive = true}),
+        ParameterDecl::number("noise", "1", "relative increase of J tolerated for the remeshing and tetrahedralisation "
+                                            "noise of the discrete J")
+            .fallback(0.01)
+            .within({.min = 0, .max = 1}),
+        ParameterDecl::number("min_step_factor", "1", "a step shorter than this × the case's Δt that still raises J is "
+                                                      "taken anyway (a jump of the discretisation, not an ascent)")
+            .fallback(0.0625)
+            .within({.min = 0, .max = 1}),
+        ParameterDecl::number("grow", "1", "Δt is multiplied by this after an accepted step").fallback(1.2).at_least(1),
+        ParameterDecl::number("max_dt_factor", "1", "cap on Δt, as a multiple of the case's Δt").fallback(4.0).at_least(1),
+        ParameterDecl::number("tolerance", "1", "converged when the best J improves by less than this (relative) over "
+                                                "`patience` accepted steps")
+            .fallback(1e-3)
+            .at_least(0),
+        ParameterDecl::integer("patience", "steps", "see tolerance").fallback(15).within({.min = 1, .max = 1000000}),
+        ParameterDecl::integer("volume_every", "states", "write volume_NNNNN.vtu (tetrahedra with u) every k states (0: "
+                                                         "never)")
+            .fallback(0)
+            .within({.min = 0, .max = 1000000}),
     };
   }
 
-  void configure(const toml::table& table) override {
-    Parameters p(table, "model");
-    p.accept("name");
-    ell_ = p.number("ell", 0.01, {.min = 0});
-    epsilon_ = p.number("epsilon", 0, {.min = 0});
-    if (p.has("epsilon") && !(epsilon_ > 0)) p.fail("epsilon", "ε must be > 0 (omit it for 3 × the mean edge)");
-    alpha_ = p.number("alpha", 2, {.min = 0});
-    conductivity_ = read_box_field(p, table, "conductivity", 1, {.min = 0, .min_exclusive = true});
-    source_ = read_box_field(p, table, "source", 1);
-    if (const toml::table* neumann = p.table("neumann")) {
-      Parameters n(*neumann, "model.neumann");
-      neumann_.value = n.number("flux", 0);
-      for (const auto& box : n.number_arrays("boxes", 7)) {
+  std::vector<OutputDecl> outputs() const override {
+    return {OutputDecl::metric("slope", "temperature/time", "J′(v): the derivative of J along the descent speed"),
+            OutputDecl::metric("ms_regularise", "ms", "the H¹ regularisation's solve"),
+            OutputDecl::metric("J", "temperature", "the objective of the accepted state"),
+            OutputDecl::metric("forced", "1", "1 when the step was taken although it raised J"),
+            OutputDecl::metric("T", "temperature", "mean temperature over the part"),
+            OutputDecl::metric("area_G", "area", "|G|"),
+            OutputDecl::metric("length_Sigma", "length", "|∂G|"),
+            OutputDecl::metric("decrease", "1", "relative decrease of J over the step"),
+            OutputDecl::metric("step", "time", "the step taken"),
+            OutputDecl::metric("tets", "1", "tetrahedra of the volume mesh"),
+            OutputDecl::metric("ms_tetgen", "ms", "tetrahedralisation"),
+            OutputDecl::metric("ms_assembly", "ms", "set-up and assembly"),
+            OutputDecl::metric("ms_factor", "ms", "analysis and factorisation"),
+            OutputDecl::metric("ms_solve", "ms", "solves"),
+            OutputDecl::vertex_field("temperature", "temperature", "u at the surface's vertices"),
+            OutputDecl::vertex_field("adjoint", "", "p at the surface's vertices"),
+            OutputDecl::vertex_field("shape_gradient", "", "the density w of J′ on the surface"),
+            OutputDecl::vertex_field("descent_speed", "1", "v, the normal speed of the descent (max |v| = 1)"),
+            OutputDecl::file("objective.csv", "J of every accepted state from T^0"),
+            OutputDecl::file("volume.pvd", "the series of volume_NNNNN.vtu (with volume_every)")};
+  }
+
+  void configure(Parameters& p) override {
+    ell_ = p.number("ell");
+    epsilon_ = p.number("epsilon", 0);
+    alpha_ = p.number("alpha");
+    conductivity_ = read_box_field(p, "conductivity");
+    source_ = read_box_field(p, "source");
+    if (p.has("neumann")) {
+      Parameters& n = p.section("neumann");
+      neumann_.value = n.number("flux");
+      for (const auto& box : n.points("boxes")) {
         std::array<double, 7> b{};
         std::copy(box.begin(), box.end(), b.begin());
         neumann_.boxes.push_back(b);
       }
-      n.reject_unknown();
     }
-    tetgen_.radius_edge_ratio = p.number("radius_edge", 1.2, {.min = 1});
-    volume_factor_ = p.number("volume_factor", 0, {.min = 0});
-    solver_.solver = linear_solver_from_string(
-        p.choice("solver", std::string(to_string(LinearSolverOptions{}.solver)),
-                 {"conjugate_gradient", "cholmod_supernodal", "cholmod_simplicial", "eigen_simplicial"}));
-    armijo_ = p.number("armijo", 1e-4, {.min = 0, .max = 1, .max_exclusive = true});
-    noise_ = p.number("noise", 0.01, {.min = 0, .max = 1});
-    min_step_factor_ = p.number("min_step_factor", 0.0625, {.min = 0, .max = 1});
-    grow_ = p.number("grow", 1.2, {.min = 1});
-    max_dt_factor_ = p.number("max_dt_factor", 4, {.min = 1});
-    tolerance_ = p.number("tolerance", 1e-3, {.min = 0});
-    patience_ = int(p.integer("patience", 15, 1, 1000000));
-    volume_every_ = int(p.integer("volume_every", 0, 0, 1000000));
-    p.reject_unknown();
+    tetgen_.radius_edge_ratio = p.number("radius_edge");
+    volume_factor_ = p.number("volume_factor");
+    solver_.solver = linear_solver_from_string(p.choice("solver"));
+    armijo_ = p.number("armijo");
+    noise_ = p.number("noise");
+    min_step_factor_ = p.number("min_step_factor");
+    grow_ = p.number("grow");
+    max_dt_factor_ = p.number("max_dt_factor");
+    tolerance_ = p.number("tolerance");
+    patience_ = int(p.integer("patience"));
+    volume_every_ = int(p.integer("volume_every"));
   }
 
   ModelNeeds needs() const override { return {.may_reject = true, .freeze_velocity = true}; }
@@ -232,7 +277,8 @@ class ThermalModel final : public VelocityModel {
 
   /// objective.csv: J of every accepted state from T^0 (history.csv's J starts at row 1, the first
   /// state a review measured).
-  void finish(const std::filesystem::path& output_dir) override {
+  void finish(const StepContext& final_state, ModelOutputs& /*outputs*/) override {
+    const std::filesystem::path& output_dir = final_state.output_dir();
     if (output_dir.empty() || history_.empty()) return;
     write_atomically(output_dir / "objective.csv", [&](std::ostream& out) {
       out << "state,J\n";

@@ -18,14 +18,22 @@ using namespace bodyfit;
 class FaultModel final : public VelocityModel {
  public:
   std::string_view name() const override { return "testfault"; }
-  void configure(const toml::table& table) override {
-    Parameters p(table, "model");
-    speed_ = p.number("speed", 1.0);
-    stage_ = p.choice("stage", "none",
-                      {"none", "configure", "compute", "end_step", "review", "save_state", "load_state", "finish"});
-    at_ = p.integer("at", 0, 0);
-    how_ = p.choice("how", "runtime_error", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size"});
-    p.reject_unknown();
+  std::vector<ParameterDecl> parameters() const override {
+    return {ParameterDecl::number("speed", "", "normal speed").fallback(1.0),
+            ParameterDecl::choice("stage", {"none", "configure", "compute", "end_step", "review", "save_state",
+                                            "load_state", "finish"},
+                                  "where the model fails")
+                .fallback("none"),
+            ParameterDecl::integer("at", "", "the iteration it fails at").fallback(0).at_least(0),
+            ParameterDecl::choice("how", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size"},
+                                  "how it fails")
+                .fallback("runtime_error")};
+  }
+  void configure(Parameters& p) override {
+    speed_ = p.number("speed");
+    stage_ = p.choice("stage");
+    at_ = p.integer("at");
+    how_ = p.choice("how");
     if (stage_ == "configure") fail();
   }
 
@@ -58,7 +66,7 @@ class FaultModel final : public VelocityModel {
     state_ = values.at(0), computes_ = values.at(1);
     if (stage_ == "load_state" && state_ == at_) fail();
   }
-  void finish(const std::filesystem::path&) override {
+  void finish(const StepContext&, ModelOutputs&) override {
     if (stage_ == "finish" && state_ == at_) fail();
   }
 

@@ -7,16 +7,15 @@ namespace {
 class GoodModel final : public bodyfit::VelocityModel {
  public:
   std::string_view name() const override { return "testgood"; }
-  std::string_view version() const override { return "2.5"; }
+  std::string_view version() const override { return "3.0"; }
   std::string_view description() const override { return "constant normal speed (test)"; }
-  std::vector<bodyfit::ParameterInfo> parameters() const override {
-    return {{"value", "0.5", "the normal speed"}};
+  std::vector<bodyfit::ParameterDecl> parameters() const override {
+    return {bodyfit::ParameterDecl::number("value", "length/time", "the normal speed").fallback(0.5).at_least(0)};
   }
-  void configure(const toml::table& table) override {
-    bodyfit::Parameters p(table, "model");
-    value_ = p.number("value", 0.5, {.min = 0});
-    p.reject_unknown();
+  std::vector<bodyfit::OutputDecl> outputs() const override {
+    return {bodyfit::OutputDecl::metric("iteration", "1", "the state's iteration")};
   }
+  void configure(bodyfit::Parameters& p) override { value_ = p.number("value"); }
   bodyfit::VelocityField compute(const bodyfit::StepContext& context) override {
     auto field = bodyfit::VelocityField::normal(bodyfit::ScalarField(context.mesh().n_vertices(), value_));
     field.metrics.emplace_back("iteration", context.iteration());

@@ -30,15 +30,23 @@ std::vector<double> arrays_of(const SurfaceMesh& mesh) {
 class LifecycleModel final : public VelocityModel {
  public:
   std::string_view name() const override { return "testlifecycle"; }
-  void configure(const toml::table& table) override {
-    Parameters p(table, "model");
-    speed_ = p.number("speed", 1.0);
-    reject_every_ = p.integer("reject_every", 0, 0);
-    stop_at_ = p.integer("stop_at", -1);
-    grow_dt_ = p.number("grow_dt", 0, {.min = 0});
-    freeze_ = p.boolean("freeze", false);
-    nan_at_ = p.integer("nan_at_vertex", -1, -1);
-    p.reject_unknown();
+  std::vector<ParameterDecl> parameters() const override {
+    return {ParameterDecl::number("speed", "", "normal speed").fallback(1.0),
+            ParameterDecl::integer("reject_every", "", "reject the first attempt of every k-th step (0: never)")
+                .fallback(0)
+                .at_least(0),
+            ParameterDecl::integer("stop_at", "", "stop the run at this iteration (-1: never)").fallback(-1),
+            ParameterDecl::number("grow_dt", "", "next Δt = this × Δt (0: the driver's)").fallback(0.0).at_least(0),
+            ParameterDecl::boolean("freeze", "needs().freeze_velocity").fallback(false),
+            ParameterDecl::integer("nan_at_vertex", "", "a NaN speed at this vertex (-1: none)").fallback(-1).at_least(-1)};
+  }
+  void configure(Parameters& p) override {
+    speed_ = p.number("speed");
+    reject_every_ = p.integer("reject_every");
+    stop_at_ = p.integer("stop_at");
+    grow_dt_ = p.number("grow_dt");
+    freeze_ = p.boolean("freeze");
+    nan_at_ = p.integer("nan_at_vertex");
   }
   ModelNeeds needs() const override { return {.may_reject = reject_every_ > 0, .freeze_velocity = freeze_}; }
 

@@ -5,7 +5,7 @@ namespace {
 class Incomplete final : public bodyfit::VelocityModel {
  public:
   std::string_view name() const override { return "testnosymbol"; }
-  void configure(const toml::table&) override {}
+  void configure(bodyfit::Parameters&) override {}
   bodyfit::VelocityField compute(const bodyfit::StepContext&) override { return {}; }
 };
 }  // namespace

@@ -6,7 +6,7 @@ namespace {
 class Throwing final : public bodyfit::VelocityModel {
  public:
   std::string_view name() const override { return "testthrowing"; }
-  void configure(const toml::table&) override { throw bodyfit::InputError("the answer must be 42"); }
+  void configure(bodyfit::Parameters&) override { throw bodyfit::InputError("the answer must be 42"); }
   bodyfit::VelocityField compute(const bodyfit::StepContext&) override { return {}; }
 };
 }  // namespace

@@ -158,6 +158,9 @@ struct EvolutionHooks {
   /// hook), with where the run stands: the caller may checkpoint it. Not called when the mesh is a
   /// candidate (a failure in the cut, the remesh or the review). Its own exceptions are logged.
   std::function<void(const SurfaceMesh&, const RunState&)> on_failure;
+  /// Where the model's finish() hands its declared grids and values (a run writes them as files,
+  /// an ensemble member keeps them). Null: they are dropped.
+  ModelOutputs* outputs = nullptr;
 
   /// No log, no callbacks (tests, benchmarks).
   static EvolutionHooks quiet() {

@@ -46,15 +46,17 @@ class GuardedModel final : public VelocityModel {
   std::string_view name() const override { return name_; }
   std::string_view version() const override { return model_.version(); }
   std::string_view description() const override { return model_.description(); }
-  std::vector<ParameterInfo> parameters() const override { return model_.parameters(); }
-  void configure(const toml::table& parameters) override;
+  std::vector<ParameterDecl> parameters() const override { return model_.parameters(); }
+  std::vector<OutputDecl> outputs() const override { return model_.outputs(); }
+  std::vector<std::string> output_files() const override { return model_.output_files(); }
+  void configure(Parameters& parameters) override;
   ModelNeeds needs() const override;
   VelocityField compute(const StepContext& context) override;
   void end_step(const StepOutcome& outcome) override;
   Review review(const StepContext& candidate, int attempt) override;
   void save_state(ModelState& state) const override;
   void load_state(const ModelState& state) override;
-  void finish(const std::filesystem::path& output_dir) override;
+  void finish(const StepContext& final_state, ModelOutputs& outputs) override;
 
  private:
   template <class Call>

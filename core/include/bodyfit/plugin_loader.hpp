@@ -6,8 +6,9 @@
 // prefix's, wherever the tree now lives; no build path is compiled in), the configured install
 // prefix's plugin directory (duplicates dropped). Every failure (no such model, dlopen error,
 // missing symbol, ABI mismatch, throwing constructor) is an InputError naming the file and reason.
-// The ABI (major << 16 | minor) is checked before anything else: the major must equal ours and the
-// plugin's minor must not exceed ours (a plugin built against older headers of the same major loads).
+// The ABI (major << 16 | minor) is checked before anything else (plugin_abi.hpp): the major must
+// equal ours and the plugin's minor must not exceed ours (a plugin built against older headers of
+// the same major loads).
 #include <bodyfit/velocity_model.hpp>
 
 #include <cstdint>
@@ -22,7 +23,8 @@ struct PluginInfo {
   std::filesystem::path file;
   std::uint32_t abi = 0;
   std::string name, version, description;
-  std::vector<ParameterInfo> parameters;
+  std::vector<ParameterDecl> parameters;
+  std::vector<OutputDecl> outputs;
 };
 
 /// A model created by a plugin, keeping the shared object loaded while the model lives.
@@ -57,12 +59,12 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures = nu
 /// contains a '/' or ends in .so.
 LoadedModel load_model(std::string_view name);
 LoadedModel load_plugin_file(const std::filesystem::path& file);
-/// Call model.set_surface(surface) (plugins built for ABI ≥ 2.4 only: older ones have no such
-/// entry in their vtable), then model.configure(parameters). An InputError (the documented way to
-/// refuse a parameter) becomes InputError "<file>: configure failed: <reason>"; any other exception
-/// PluginError "<file>: model '<name>' failed in configure: <reason>".
+/// Call model.set_surface(surface), then model.configure() with the [model] table read through the
+/// model's declarations, then refuse every key of the table that configure() did not read
+/// (Parameters::check_consumed: unknown keys, and declared keys these settings do not use). An
+/// InputError thrown by configure (the documented way to refuse a parameter) becomes InputError
+/// "<file>: configure failed: <reason>"; any other exception PluginError "<file>: model '<name>'
+/// failed in configure: <reason>" (a key read that the model did not declare is one).
 void configure_model(LoadedModel& model, const toml::table& parameters, const SurfaceSource& surface = {});
-/// Decode kPluginAbi-style numbers: "1.0".
-std::string abi_string(std::uint32_t abi);
 
 }  // namespace bodyfit

@@ -5,8 +5,9 @@
 //   uint32_t bodyfit_plugin_abi();            // kPluginAbi of the headers it was built with
 //   bodyfit::VelocityModel* bodyfit_create(); // a new model, owned by the caller
 //   void bodyfit_destroy(bodyfit::VelocityModel*);
-// The loader checks the ABI before calling anything else. A model is created once per run and
-// configured once from its TOML table; the model object lives for the whole run and may keep state.
+// The loader checks the ABI before calling anything else (plugin_abi.hpp: what must match). A
+// model declares the parameters it takes and the outputs it gives, is created once per run and
+// configured once through its declarations; the object lives for the whole run and may keep state.
 //
 // The life of one step n (docs/plugins.md has the whole picture):
 //   compute(T^n)            V^n (once per CFL sub-step, or once per step with needs().freeze_velocity)
@@ -14,13 +15,14 @@
 //   review(candidate T^{n+1}) accept / reject (the driver restores T^n and retries with Δt/2; only
 //                          with needs().may_reject) / stop the run / ask for the next Δt
 //   save_state / load_state  what the model keeps goes into every checkpoint and comes back on --resume
-//   finish(output_dir)      once, after the last state
+//   finish(T^N, outputs)    once, with the final state: its declared grids and values
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/model_outputs.hpp>
 #include <bodyfit/model_state.hpp>
+#include <bodyfit/parameters.hpp>
+#include <bodyfit/plugin_abi.hpp>
 
 #include <Eigen/SparseCore>
-#include <toml++/toml.h>
-
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -32,17 +34,6 @@
 #include <vector>
 
 namespace bodyfit {
-
-inline constexpr std::uint32_t kPluginAbiMajor = 2;
-inline constexpr std::uint32_t kPluginAbiMinor = 5;
-inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
-
-/// One parameter a model accepts, for `bodyfit plugins` and for error messages.
-struct ParameterInfo {
-  std::string name;
-  std::string default_value;  ///< as written in TOML ("" when required)
-  std::string description;    ///< with its unit
-};
 
 /// What compute() returns: a tangential vector field V at the vertices, or a normal speed v
 /// (then V = v·n_Σ with n_Σ the extended unit conormal, a positive v growing G).
@@ -215,10 +206,17 @@ class VelocityModel {
   virtual std::string_view name() const = 0;
   virtual std::string_view version() const { return "1.0"; }
   virtual std::string_view description() const { return ""; }
-  virtual std::vector<ParameterInfo> parameters() const { return {}; }
-  /// Validate and take the model's parameters (the [model] table of the case, without `name`).
-  /// Throw InputError on an unknown key or a bad value, naming the key.
-  virtual void configure(const toml::table& parameters) = 0;
+  /// The parameters of the model's [model] table, declared once: `bodyfit plugins --describe`
+  /// prints them, the docs' reference is made from them, and configure() reads through them.
+  virtual std::vector<ParameterDecl> parameters() const { return {}; }
+  /// What the model gives: its vertex fields, history columns, grids and files.
+  virtual std::vector<OutputDecl> outputs() const { return {}; }
+  /// What S was built from, given once before configure(). Default: ignored.
+  virtual void set_surface(const SurfaceSource& /*source*/) {}
+  /// Take the model's parameters (the [model] table of the case, without `name`), read through
+  /// the declarations: p.number("speed"). Throw InputError on a bad value (p.fail names the key).
+  /// The driver then refuses every key that was set and not read (Parameters::check_consumed).
+  virtual void configure(Parameters& parameters) = 0;
   /// What the model needs from the driver (see ModelNeeds). Default: nothing special.
   virtual ModelNeeds needs() const { return {}; }
   /// V^n on the current mesh.
@@ -236,16 +234,17 @@ class VelocityModel {
   /// Restore it on --resume (after configure, before the first step). Throw InputError on a
   /// state the model cannot read.
   virtual void load_state(const ModelState& /*state*/) {}
-  /// Called once when the run ends (after the last state); may write files to output_dir.
-  virtual void finish(const std::filesystem::path& /*output_dir*/) {}
-  /// (ABI 2.3) The names of the files the model may write in the output directory, whatever its
-  /// settings (every format of a file, its default names): `bodyfit run --overwrite` removes
-  /// them with the driver's own, so a replaced run leaves none of the previous run's files.
-  virtual std::vector<std::string> output_files() const { return {}; }
-  /// (ABI 2.4) What S was built from, given once before configure() (configure_model passes it;
-  /// plugins built for an older ABI are not asked). Default: ignored.
-  virtual void set_surface(const SurfaceSource& /*source*/) {}
+  /// Called once when the run ends, with the final state: hand the declared grids and values to
+  /// `outputs`, write the model's own files in final_state.output_dir() (when not empty).
+  virtual void finish(const StepContext& /*final_state*/, ModelOutputs& /*outputs*/) {}
+  /// The names of the files the model may write in the output directory, whatever its settings
+  /// (`bodyfit run --overwrite` removes them with the driver's own). Default: the declared files
+  /// and grids (both formats).
+  virtual std::vector<std::string> output_files() const;
 };
+
+/// The file names of declared outputs: File outputs as named, Grid outputs as <name>.tif, .asc, .prj.
+std::vector<std::string> declared_output_files(const std::vector<OutputDecl>& outputs);
 
 }  // namespace bodyfit
 

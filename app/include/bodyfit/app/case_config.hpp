@@ -11,7 +11,8 @@
 //   [time]       dt | cfl (Δt = cfl·h);  final_time and/or iterations; max_cfl, narrow_band, keep_crossings, max_substeps,
 //                compose_substeps, max_rejections; start = "2026-07-14T13:00:00Z" (the clock time of t = 0)
 //   [distance] [advection] [discretize] [remesh]   options of each stage
-//   [output]     vtu_every, png_every, field, view, size = [w, h], checkpoint_every, checkpoint_seconds
+//   [output]     vtu_every, png_every, field, view, size = [w, h], checkpoint_every, checkpoint_seconds,
+//                grid_format
 //
 // Every table and key is checked (with bodyfit::Parameters): an unknown one is an InputError with a
 // suggestion ("case.toml:9: unknown key 'final_tiem' in [time]; did you mean 'final_time'?"), as is
@@ -20,6 +21,7 @@
 // Two halves: reading a case (case_config.cpp: apply_override, parse_case, read_case) and setting
 // up its run (case_setup.cpp: make_case_surface ... setup_case). They share this header because a
 // run needs both and the set-up functions take the CaseConfig.
+#include <bodyfit/app/config.hpp>
 #include <bodyfit/advection.hpp>
 #include <bodyfit/distance.hpp>
 #include <bodyfit/evolution.hpp>
@@ -103,6 +105,9 @@ struct OutputSpec {
   /// its end and on SIGINT (docs/running.md).
   int checkpoint_every = 0;         ///< iterations
   double checkpoint_seconds = 30;   ///< wall-clock seconds since the last checkpoint
+  /// The format of the model's grid outputs: "tif" (GeoTIFF: CRS, NODATA, units; with GDAL) or
+  /// "asc" (ESRI ASCII grid + .prj).
+  std::string grid_format = config::have_gdal ? "tif" : "asc";
 };
 
 struct CaseConfig {
