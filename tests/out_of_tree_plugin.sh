@@ -96,4 +96,17 @@ column=$(head -n1 "$work/part/history.csv" | tr ',' '\n' | grep -n '^accepted_st
 [[ $(tail -n1 "$work/part/history.csv" | cut -d, -f"$column") == 4 ]] || { cat "$work/part/history.csv"; fail "model state not restored"; }
 cmp -s "$work/part/final.mesh" "$work/full/final.mesh" || fail "the resumed run's final mesh differs"
 
+step "the minimal example (examples/constant): built and run the same way"
+cmake -S "$source/examples/constant" -B "$work/constant-build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  "${launcher[@]}" > "$work/constant-configure.log" 2>&1 || { cat "$work/constant-configure.log"; fail "configure constant"; }
+cmake --build "$work/constant-build" > "$work/constant-build.log" 2>&1 || { cat "$work/constant-build.log"; fail "build constant"; }
+sed 's/^name = "windy"$/name = "constant"/; /^base\|^wind\|^smoothing/d' "$work/case.toml" > "$work/constant.toml"
+BODYFIT_PLUGIN_PATH="$work/constant-build" "$work/prefix/bin/bodyfit" run "$work/constant.toml" -o "$work/constant" \
+  --set model.speed=1.0 > "$work/constant.log" 2>&1 || { cat "$work/constant.log"; fail "bodyfit run with the constant model"; }
+# A cap of polar angle 45° on the unit sphere grown at unit speed for 0.04: angle π/4 + 0.04.
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "area") c = i } END {
+           exact = 2 * 3.141592653589793 * (1 - cos(3.141592653589793 / 4 + 0.04))
+           if ($c < 0.99 * exact || $c > 1.01 * exact) { print "area " $c " against " exact; exit 1 } }' \
+  "$work/constant/history.csv" || fail "the constant model's cap is not the exact one"
+
 echo "out-of-tree plugin: OK"

@@ -8,6 +8,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -43,9 +44,11 @@ TEST_CASE("the shipped ensemble's members sample only keys their model reads") {
   CHECK(run.combined[0].name == "arrival_time");
   // A key the model does not read with these settings (R0 comes from the fuel classes here) is refused.
   test::TempDir dir("shipped_ensemble_r0");
+  // The case with its data files named absolutely, and R0 sampled.
+  const std::string dem = fmt::format("\"{}/", (fs::path(BODYFIT_SOURCE_DIR) / "meshes" / "dem").string());
   std::string text = test::read_file(file);
   for (std::size_t at = text.find("\"../dem/"); at != std::string::npos; at = text.find("\"../dem/", at))
-    text.replace(at, 8, "\"" + (fs::path(BODYFIT_SOURCE_DIR) / "meshes" / "dem").string() + "/");
+    text.replace(at, 8, dem);
   text += "\"model.R0\" = {dist = \"uniform\", min = 0.3, max = 0.5}\n";  // [ensemble.sample] is the last table
   std::ofstream(dir / "case.toml") << text;
   run = EnsembleRun{};

@@ -95,21 +95,16 @@ bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const std::a
   if (std::find(run.inject_failures.begin(), run.inject_failures.end(), s.index) != run.inject_failures.end())
     throw NumericalError("injected failure (--inject-failure, a test hook)");
 
-  const CaseConfig config = member_case(run, s);
-  LoadedModel model = load_case_model(config);
-  CaseSetup setup = setup_case(config);
-  if (region_area(setup.mesh, kInside) <= 0)
+  Run member(member_case(run, s), {});  // no files of its own: its grids come to the ensemble
+  if (region_area(member.mesh(), kInside) <= 0)
     throw InputError(fmt::format("G(0), the disk at ({}, {}) of radius {}, covers no face of the surface (outside "
                                  "S, or smaller than its triangles)",
                                  s.x, s.y, run.domain.radius));
-  setup.options.output_dir.clear();  // a member keeps no files of its own: its grids come to the ensemble
-  setup.options.height_field = config.surface.kind == SurfaceSpec::Kind::Terrain;
-  GuardedModel guarded(model.model(), 0);
-  KeptOutputs kept(model->outputs(), std::string(model->name()));
+  KeptOutputs kept(member.model()->outputs(), std::string(member.model()->name()));
   EvolutionHooks hooks = EvolutionHooks::quiet();
   hooks.stop = stop;
   hooks.outputs = &kept;
-  const EvolutionResult result = evolve(setup.mesh, guarded, setup.options, {}, hooks);
+  const EvolutionResult result = member.evolve({}, hooks);
   if (result.reason == StopReason::Interrupted) return false;
   if (result.reason == StopReason::Rejected) throw PluginError(result.message);
   record.final_time = result.time;
@@ -122,7 +117,7 @@ bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const std::a
     if (it == kept.grids().end())
       throw PluginError(fmt::format("model '{}' gave no '{}' grid at the end of the run: an ensemble combines the "
                                     "grids a model declares, and this run gave none",
-                                    config.model, d.name));
+                                    run.model, d.name));
     write_raster(member_grid_path(run.outdir, s.index, d.name), to_raster(it->second),
                  raster_metadata(it->second, d.unit));
   }

@@ -429,7 +429,6 @@ class Evolution {
     Stopwatch clock;
     if (hooks_.on_iteration) hooks_.on_iteration(mesh_, record, RunState{n_, t_, dt_});
     record.ms.output += clock.lap_ms();
-    if (hooks_.log) log(record);
     result_.records.push_back(std::move(record));
     if (review.stop) stop(StopReason::ModelStop, review.reason.empty() ? "the model stopped the run" : review.reason);
   }
@@ -518,16 +517,6 @@ class Evolution {
     result_.message = std::move(message);
   }
   double tiny() const { return 1e-9 * options_.dt; }
-  void log(const IterationRecord& r) const {
-    spdlog::info("n={} t={:.5g} |G|={:.6g} |dG|={:.6g} comp={} faces={} qmin={:.3f} ms: vel {:.1f} dist {:.1f} "
-                 "adv {:.1f} disc {:.1f} remesh {:.1f}{} out {:.1f}{}{}",
-                 r.iteration, r.time, r.area, r.interface_length, r.components, r.faces, r.min_quality, r.ms.velocity,
-                 r.ms.distance, r.ms.advect, r.ms.discretize, r.ms.remesh,
-                 r.ms.review > 0.05 ? fmt::format(" review {:.1f}", r.ms.review) : std::string(), r.ms.output,
-                 r.substeps > 1 ? fmt::format(" ({} sub-steps)", r.substeps) : std::string(),
-                 r.rejections > 0 ? fmt::format(" ({} rejected)", r.rejections) : std::string());
-  }
-
   SurfaceMesh& mesh_;
   VelocityModel& model_;
   const EvolutionOptions& options_;

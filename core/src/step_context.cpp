@@ -45,6 +45,8 @@ struct StepContext::Impl {
   mutable std::optional<std::vector<double>> face_areas;
   mutable std::optional<VectorField> face_normals, vertex_normals, surface_normals, conormal;
   mutable std::optional<Eigen::SparseMatrix<double>> mass, stiffness;
+  mutable std::optional<std::vector<double>> lumped_mass;
+  mutable std::optional<ScalarField> front_curvature;
   mutable std::map<double, H1Smoother> smoothers;  // one factorisation per length
 
   const SurfaceMesh& mesh() const { return *state.mesh; }
@@ -198,6 +200,20 @@ const Eigen::SparseMatrix<double>& StepContext::mass_matrix() const {
 const Eigen::SparseMatrix<double>& StepContext::stiffness_matrix() const {
   std::lock_guard lock(impl_->mutex);
   return impl_->stiffness_locked();
+}
+
+const std::vector<double>& StepContext::lumped_mass() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->lumped_mass) impl_->lumped_mass = bodyfit::lumped_mass(mesh());
+  return *impl_->lumped_mass;
+}
+
+ScalarField StepContext::divergence(const VectorField& field) const { return surface_divergence(mesh(), field); }
+
+const ScalarField& StepContext::front_curvature() const {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->front_curvature) impl_->front_curvature = level_set_curvature(mesh(), distance());
+  return *impl_->front_curvature;
 }
 
 ScalarField StepContext::smooth(const ScalarField& f, double length) const {

@@ -6,6 +6,7 @@
 #include <Eigen/SparseCholesky>
 #include <fmt/format.h>
 
+#include <array>
 #include <stdexcept>
 #include <utility>
 
@@ -141,6 +142,56 @@ ScalarField smooth_h1(const SurfaceMesh& mesh, const ScalarField& f, double leng
 
 VectorField smooth_h1(const SurfaceMesh& mesh, const VectorField& f, double length) {
   return H1Smoother(mesh, length).smooth(f);
+}
+
+namespace {
+
+/// −(1/m_i) Σ_T area_T · w_T·∇φ_i at the vertices, for one vector w_T per face (`face_vector`).
+template <class FaceVector>
+ScalarField weak_divergence(const SurfaceMesh& mesh, FaceVector&& face_vector) {
+  ScalarField divergence(mesh.n_vertices(), 0.0);
+  const std::vector<double> mass = lumped_mass(mesh);
+  for (auto f : mesh.faces()) {
+    std::array<VertexHandle, 3> v;
+    std::array<Vec3, 3> p;
+    int k = 0;
+    for (auto fv : mesh.fv_range(f)) v[k] = fv, p[k] = mesh.point(fv), ++k;
+    const Vec3 cross = OpenMesh::cross(p[1] - p[0], p[2] - p[0]);  // |cross| = 2 area
+    const double twice_area = cross.norm();
+    if (!(twice_area > 0)) continue;
+    const Vec3 normal = cross / twice_area;
+    const Vec3 w = face_vector(f, v);
+    for (int i = 0; i < 3; ++i) {
+      // ∇φ_i = n × (the edge opposite i, oriented) / (2 area).
+      const Vec3 gradient = OpenMesh::cross(normal, p[(i + 2) % 3] - p[(i + 1) % 3]) / twice_area;
+      divergence[v[i].idx()] -= 0.5 * twice_area * OpenMesh::dot(w, gradient);
+    }
+  }
+  for (std::size_t i = 0; i < divergence.size(); ++i)
+    divergence[i] = mass[i] > 0 ? divergence[i] / mass[i] : 0.0;
+  return divergence;
+}
+
+}  // namespace
+
+ScalarField surface_divergence(const SurfaceMesh& mesh, const VectorField& field) {
+  if (field.size() != mesh.n_vertices())
+    throw InputError(fmt::format("surface_divergence: {} vectors for {} vertices", field.size(), mesh.n_vertices()));
+  // V linear on each face: ∫_T V·∇φ_i = area · V̄·∇φ_i with V̄ the mean of its corners.
+  return weak_divergence(mesh, [&](FaceHandle, const std::array<VertexHandle, 3>& v) {
+    return (field[v[0].idx()] + field[v[1].idx()] + field[v[2].idx()]) / 3.0;
+  });
+}
+
+ScalarField level_set_curvature(const SurfaceMesh& mesh, const ScalarField& d) {
+  if (d.size() != mesh.n_vertices())
+    throw InputError(fmt::format("level_set_curvature: {} values for {} vertices", d.size(), mesh.n_vertices()));
+  const VectorField gradients = face_gradients(mesh, d);
+  return weak_divergence(mesh, [&](FaceHandle f, const std::array<VertexHandle, 3>&) {
+    const Vec3& g = gradients[f.idx()];
+    const double length = g.norm();
+    return length > 0 ? g / length : Vec3(0, 0, 0);
+  });
 }
 
 }  // namespace bodyfit

@@ -142,7 +142,7 @@ struct EvolutionResult;
 
 /// What the caller observes and controls while a run goes on.
 struct EvolutionHooks {
-  bool log = true;               ///< one spdlog info line per iteration (and per rejected step)
+  bool log = true;               ///< an spdlog info line per rejected step and per region joining G
   const std::atomic<bool>* stop = nullptr;  ///< raised by the caller (e.g. SIGINT) to stop cleanly
   /// Output stage: called for every state T^n (see StateView); its time is counted as "output".
   std::function<void(const StateView&)> on_state;

@@ -138,6 +138,18 @@ class StepContext {
   /// P1 mass and stiffness matrices on T^n (vertex-indexed).
   const Eigen::SparseMatrix<double>& mass_matrix() const;
   const Eigen::SparseMatrix<double>& stiffness_matrix() const;
+  /// The lumped mass: a third of the area of the faces around each vertex (the row sums of M).
+  const std::vector<double>& lumped_mass() const;
+  /// div_S V at the vertices (surface_fem.hpp, surface_divergence): the weak, lumped form; on the
+  /// boundary of an open surface it also holds the flux through the boundary.
+  ScalarField divergence(const VectorField& field) const;
+  /// The curvature of the level sets of d at the vertices: κ = div_S(∇_S d/|∇_S d|)
+  /// (surface_fem.hpp, level_set_curvature; for a front on a surface, its geodesic curvature,
+  /// > 0 where G is convex). Singular where ∇_S d vanishes — on the ridges of d, the medial axes
+  /// of G and of its complement (the centre of a disk): there κ grows like 1/h and means nothing.
+  /// Use it near the front (|d| below the smallest radius of curvature), or clip it. In a band
+  /// sub-step, valid at the active vertices only. Computed once per context.
+  const ScalarField& front_curvature() const;
   /// H¹ smoothing: u solving (M + ℓ²K) u = M f; for vector fields, component-wise then
   /// projected on the tangent planes. ℓ is a length (0 returns f).
   ScalarField smooth(const ScalarField& f, double length) const;
