@@ -16,3 +16,32 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/bodyfitConfigVersion.cmak
 install(FILES ${PROJECT_BINARY_DIR}/bodyfitConfig.cmake ${PROJECT_BINARY_DIR}/bodyfitConfigVersion.cmake
         ${PROJECT_SOURCE_DIR}/cmake/BodyfitPlugin.cmake
         DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/bodyfit)
+
+# pkg-config files (for builds without CMake): the engine and the application library, relocatable
+# (prefix from the .pc file's own place: <libdir>/pkgconfig), like the rest of an install.
+foreach(dir LIBDIR INCLUDEDIR)
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_${dir}}")
+    set(BODYFIT_PC_${dir} "${CMAKE_INSTALL_${dir}}")
+  else()
+    set(BODYFIT_PC_${dir} "\${prefix}/${CMAKE_INSTALL_${dir}}")
+  endif()
+endforeach()
+set(BODYFIT_PC_PLUGINDIR "\${libdir}/bodyfit/plugins")
+foreach(pc bodyfit bodyfit-app)
+  configure_file(${PROJECT_SOURCE_DIR}/cmake/${pc}.pc.in ${PROJECT_BINARY_DIR}/${pc}.pc @ONLY)
+  install(FILES ${PROJECT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+endforeach()
+
+# What users need beside the programs: the example cases with their DEMs and parts, the example
+# plugins (share/bodyfit, where `bodyfit --help` points), the manual and the licences
+# (share/doc/bodyfit), the man page and the bash completion the driver writes of itself.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/meshes/cases ${PROJECT_SOURCE_DIR}/meshes/dem ${PROJECT_SOURCE_DIR}/meshes/parts
+                  ${PROJECT_SOURCE_DIR}/examples
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bodyfit)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/plugins/thermal/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR}
+        RENAME LICENSE.thermal-plugin)
+install(FILES ${PROJECT_BINARY_DIR}/share/man/man1/bodyfit.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+install(FILES ${PROJECT_BINARY_DIR}/share/bash-completion/completions/bodyfit
+        DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)

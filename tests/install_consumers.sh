@@ -213,4 +213,40 @@ if [[ -f "$build/lib/bodyfit/libbodyfit_map.so" ]]; then
   [[ -s "$work/small_map.png" ]] || fail "no map drawn"
 fi
 
+step "what users need beside the programs: cases and their data, licences, the manual, man page, completion"
+data="$prefix/share/bodyfit"
+for item in cases/sphere_cap.toml cases/fire_luxembourg.toml dem/luxembourg_elev_200m.asc parts/bracket_h0.07.mesh \
+            examples/plugin/windy.cpp examples/constant/constant.cpp; do
+  [[ -f "$data/$item" ]] || fail "share/bodyfit/$item not installed"
+done
+"$prefix/bin/bodyfit" --help | grep -qF "$data/cases" || fail "bodyfit --help does not point to $data/cases"
+# An installed case runs from anywhere (its DEM and fuel map named relative to it).
+(cd "$work" && "$prefix/bin/bodyfit" -q run "$data/cases/fire_luxembourg.toml" -o "$work/lux" \
+   --set time.final_time=600 --set output.png_every=0 --set model.perimeters.file='""') \
+  || fail "the installed fire_luxembourg case does not run"
+for doc in LICENSE LICENSE.thermal-plugin README.md architecture.md; do
+  [[ -f "$prefix/share/doc/bodyfit/$doc" ]] || fail "share/doc/bodyfit/$doc not installed"
+done
+[[ -f "$data/dem/README.md" ]] || fail "the DEM's licence note is not installed with it"
+head -n1 "$prefix/share/man/man1/bodyfit.1" | grep -q '^\.TH BODYFIT 1' || fail "no man page"
+grep -q "bodyfit ensemble" "$prefix/share/man/man1/bodyfit.1" || fail "the man page lacks a command"
+if command -v man > /dev/null; then
+  man -l "$prefix/share/man/man1/bodyfit.1" 2>&1 | grep -q "exactly meshed" || fail "man cannot render the page"
+fi
+completion="$prefix/share/bash-completion/completions/bodyfit"
+bash -n "$completion" || fail "the bash completion does not parse"
+words=$(bash -c "source '$completion'; COMP_WORDS=(bodyfit run --ov); COMP_CWORD=2; _bodyfit; echo \"\${COMPREPLY[*]}\"")
+[[ $words == --overwrite ]] || fail "the completion of 'bodyfit run --ov' is '$words'"
+
+step "pkg-config: a plugin built without CMake, loaded by the C program"
+export PKG_CONFIG_PATH="$prefix/lib/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"
+flags=$(pkg-config --cflags --libs bodyfit) || fail "pkg-config bodyfit"
+# shellcheck disable=SC2086
+c++ -O2 -shared -fPIC -fvisibility=hidden "$source/examples/constant/constant.cpp" $flags \
+  -Wl,-rpath,"$(pkg-config --variable=libdir bodyfit)" -o "$work/bodyfit_constant.so" || fail "building with pkg-config"
+out=$("$work/load_plugin" "$work/bodyfit_constant.so" "$abi" "$soname" 2>&1) || { echo "$out"; fail "loading it"; }
+[[ $(cd "$(pkg-config --variable=plugindir bodyfit)" && pwd -P) == $(cd "$plugin_dir" && pwd -P) ]] \
+  || fail "pkg-config's plugindir is not $plugin_dir"
+pkg-config --exists bodyfit-app || fail "pkg-config bodyfit-app"
+
 echo "install consumers: OK"

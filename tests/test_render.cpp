@@ -9,6 +9,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <fstream>
@@ -146,6 +147,26 @@ TEST_CASE("bodyfit render: CLI writes the PNG at --size") {
   r = test::run_bodyfit("render " + (dir / "cap.mesh").string() + " -o " + (dir / "x.png").string() + " --size 30");
   CHECK(r.exit_code == 1);
   CHECK(r.output.find("--size '30'") != std::string::npos);
+}
+
+TEST_CASE("bodyfit render and info read the VTU files a run writes, with their fields") {
+  test::TempDir dir("render-vtu");
+  const SurfaceMesh mesh = sphere_with_cap();
+  VtuFields fields;
+  ScalarField height(mesh.n_vertices());
+  for (auto v : mesh.vertices()) height[v.idx()] = mesh.point(v)[2];
+  fields.point_scalars.emplace_back("speed", height);
+  write_vtu(mesh, dir / "step.vtu", fields);
+  auto r = test::run_bodyfit("render " + (dir / "step.vtu").string() + " -o " + (dir / "speed.png").string() +
+                             " --field speed --size 300x200");
+  REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+  CHECK(read_png(dir / "speed.png").width == 300);
+  r = test::run_bodyfit("render " + (dir / "step.vtu").string() + " -o " + (dir / "x.png").string() + " --field sped");
+  CHECK(r.exit_code == 1);
+  CHECK(r.output.find("a field of the VTU (phi, speed)") != std::string::npos);
+  r = test::run_bodyfit("info " + (dir / "step.vtu").string() + " --json");
+  REQUIRE_MESSAGE(r.exit_code == 0, r.output);
+  CHECK(r.output.find(fmt::format("\"faces\": {}", mesh.n_faces())) != std::string::npos);
 }
 
 TEST_CASE("the top view is a map: x (east) to the right, y (north) up") {

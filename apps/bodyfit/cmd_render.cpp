@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <memory>
 
 namespace {
@@ -23,7 +24,9 @@ struct RenderArguments {
 };
 
 int render_command(const RenderArguments& args) {
-  SurfaceMesh mesh = read_mesh(args.input);
+  VtuFields vtu;  // a VTU carries its fields: the run's d, velocity, the model's
+  const bool is_vtu = fs::path(args.input).extension() == ".vtu";
+  SurfaceMesh mesh = is_vtu ? read_vtu(args.input, &vtu) : read_mesh(args.input);
   mesh.garbage_collection();
   RenderOptions options;
   set_view(options, args.view);
@@ -39,7 +42,12 @@ int render_command(const RenderArguments& args) {
   options.width = w, options.height = h;
 
   const std::string& field = args.field;
-  if (field.size() > 4 && (field.ends_with(".sol") || field.ends_with(".solb"))) {
+  auto in_vtu = std::find_if(vtu.point_scalars.begin(), vtu.point_scalars.end(),
+                             [&](const auto& named) { return named.first == field; });
+  if (in_vtu != vtu.point_scalars.end()) {
+    options.field = in_vtu->second;
+    options.field_name = field;
+  } else if (field.size() > 4 && (field.ends_with(".sol") || field.ends_with(".solb"))) {
     options.field = read_scalar_sol(field, mesh.n_vertices());
     options.field_name = fs::path(field).stem().string();
   } else if (field == "d") {
@@ -53,8 +61,12 @@ int render_command(const RenderArguments& args) {
     options.field_name = "phi";
   } else if (field != "region") {
     options.field = named_vertex_field(mesh, field);
-    if (options.field.empty())
-      throw InputError(fmt::format("--field '{}': expected region, phi, d, quality, height or a .sol file", field));
+    if (options.field.empty()) {
+      std::string in_file;
+      for (const auto& [name, values] : vtu.point_scalars) in_file += ", " + name;
+      throw InputError(fmt::format("--field '{}': expected region, phi, d, quality, height, a .sol file{}", field,
+                                   in_file.empty() ? std::string() : " or a field of the VTU (" + in_file.substr(2) + ")"));
+    }
     options.field_name = field;
   }
   render_png(mesh, args.output, options);
@@ -66,9 +78,10 @@ bodyfit::cli::Command setup_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "render a mesh to a PNG image (region colours or a field with a colorbar)");
   auto args = std::make_shared<RenderArguments>();
   // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
-  cmd->add_option("mesh", args->input, "input mesh")->required();
+  cmd->add_option("mesh", args->input, "input mesh (any format read_mesh reads, .vtu with its fields)")->required();
   cmd->add_option("-o,--output", args->output, "output .png")->required();
-  cmd->add_option("--field", args->field, "region | phi | d | quality | height | a .sol file")->capture_default_str();
+  cmd->add_option("--field", args->field, "region | phi | d | quality | height | a .sol file | a point field of the .vtu")
+      ->capture_default_str();
   cmd->add_option("--view", args->view, "iso | top | front")->capture_default_str();
   cmd->add_option("--azimuth", args->azimuth, "camera azimuth in degrees (overrides --view)");
   cmd->add_option("--elevation", args->elevation, "camera elevation in degrees (overrides --view)");

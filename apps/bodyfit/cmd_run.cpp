@@ -210,7 +210,7 @@ bodyfit::cli::Command setup_run(CLI::App& app) {
       ->excludes(resume);
   cmd->add_flag("--force", args->force, "with --resume: continue even though the case differs from the checkpoint's")
       ->needs(resume);
-  cmd->add_flag("-v,--verbose", args->verbose, "the milliseconds of each stage on every iteration's line");
+  cmd->add_flag("--verbose", args->verbose, "the milliseconds of each stage on every iteration's line");
   // Test hooks (no group: hidden from --help): a crash or Ctrl-C at a known point of the run.
   cmd->add_option("--inject-signal", args->inject_signal, "")->group("");
   cmd->add_option("--inject-fault", args->inject_fault, "")->group("");

@@ -1,7 +1,9 @@
 // bodyfit: body-fitted tracking of a region moving inside a fixed surface.
 #include "commands.hpp"
 #include "mmg_spellings.hpp"
+#include "self_documentation.hpp"
 
+#include <bodyfit/app/shared_data.hpp>
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
@@ -14,8 +16,9 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
-#include <string>
 #include <cstdio>
+#include <string>
+#include <string_view>
 #include <exception>
 #include <optional>
 #include <vector>
@@ -44,12 +47,22 @@ int main(int argc, char** argv) {
   // by about a fifth (docs/performance.md).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  // The build's own documentation of the command line (self_documentation.hpp) names no path of
+  // this machine.
+  const bool documenting = argc == 2 && (std::string_view(argv[1]) == "--man-page" ||
+                                         std::string_view(argv[1]) == "--bash-completion");
+  const std::filesystem::path data = documenting ? std::filesystem::path() : shared_data_directory();
+  const std::string examples =
+      data.empty() ? std::string("the example cases in share/bodyfit/cases of the install prefix (meshes/cases "
+                                 "of the sources)")
+                   : fmt::format("the example cases in {}, e.g.\n  bodyfit run {} -o out", (data / "cases").string(),
+                                 (data / "cases" / "sphere_cap.toml").string());
   CLI::App app{
       "bodyfit — track a region G(t) moving inside a fixed triangulated surface S, keeping G and\n"
       "S\\G exactly meshed at every step (level set + body-fitted remeshing).\n\n"
       "Every stage is also a subcommand that reads and writes Medit .mesh/.sol files, so it can\n"
-      "replace mmgs, mshdist or advect one stage at a time. Start with `bodyfit run case.toml`\n"
-      "(see meshes/ for example cases) or `bodyfit mesh sphere --faces 20000 -o s.mesh`.",
+      "replace mmgs, mshdist or advect one stage at a time. Start with `bodyfit run case.toml`:\n" +
+          examples + "\nor with `bodyfit mesh sphere --faces 20000 -o s.mesh`. Each command's --help explains it.",
       "bodyfit"};
   app.set_version_flag("--version", std::string("bodyfit ") + config::version);
   app.require_subcommand(1);
@@ -61,17 +74,23 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "worker threads of the parallel stages (0: all cores); results do not depend on it")
       ->check(CLI::Range(0, 4096));
   std::size_t max_faces = default_max_faces();
-  app.add_option("--max-faces", max_faces,
-                 fmt::format("refuse to build or remesh to more faces than this, estimated before starting (0: no "
-                             "limit; default: what fits in 3/4 of this machine's memory at {:.0f} bytes per face)",
-                             kBytesPerFace))
-      ->capture_default_str();
+  auto* max_faces_option =
+      app.add_option("--max-faces", max_faces,
+                     fmt::format("refuse to build or remesh to more faces than this, estimated before starting (0: no "
+                                 "limit; default: what fits in 3/4 of this machine's memory at {:.0f} bytes per face)",
+                                 kBytesPerFace));
+  if (!documenting) max_faces_option->capture_default_str();
 
   auto& commands = cli::registry();
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<cli::Command> added;
   for (auto& [order, setup] : commands) added.push_back(setup(app));
+  if (documenting)
+    return std::fputs((std::string_view(argv[1]) == "--man-page" ? cli::man_page(app, config::version)
+                                                                   : cli::bash_completion(app))
+                          .c_str(),
+                      stdout) < 0;
 
   // MMG's spellings (-hmax 0.1, -in, -out, -sol, -ls, -nr): translated on discretize and remesh,
   // refused elsewhere (mmg_spellings.hpp) — never the help and exit 0.

@@ -352,7 +352,9 @@ SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& opti
   if (ext == ".obj") return read_obj(file, options);
   if (ext == ".ply") return read_ply(file, options);
   if (ext == ".stl") return read_openmesh_format(file, options);
-  throw file_error(file, fmt::format("unknown mesh extension '{}' (expected .mesh, .meshb, .obj, .off, .ply or .stl)",
+  if (ext == ".vtu") return read_vtu(file, nullptr, options);
+  throw file_error(file, fmt::format("unknown mesh extension '{}' (expected .mesh, .meshb, .obj, .off, .ply, .stl or "
+                                     ".vtu)",
                                      ext));
 }
 

@@ -25,7 +25,7 @@ struct ReadOptions {
   double min_relative_area = 1e-14;
 };
 
-/// Read any supported mesh format (.mesh .meshb .obj .off .ply .stl), chosen by extension.
+/// Read any supported mesh format (.mesh .meshb .obj .off .ply .stl .vtu), chosen by extension.
 /// Medit refs and tags map onto the mesh properties (see docs/formats.md); e:interface is set on
 /// edges listed with ref 10 and on edges between a face of region 3 and a face of another region.
 SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {});
@@ -63,6 +63,11 @@ struct VtuFields {
 /// Write the mesh as a VTK XML UnstructuredGrid (raw binary appended data). The face region and
 /// quality and the vertex φ are always written; `fields` adds more.
 void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const VtuFields& fields = {});
+/// Read a VTK XML UnstructuredGrid of triangles (bodyfit's own, or one ParaView saved without
+/// compression: raw or base64 appended data, inline base64 or ASCII, UInt32 or UInt64 headers): the
+/// cell data "region" gives the regions and the point data "phi" φ; the other fields go to
+/// `fields` when given. read_mesh reads .vtu files through it.
+SurfaceMesh read_vtu(const std::filesystem::path& file, VtuFields* fields = nullptr, const ReadOptions& options = {});
 
 /// A ParaView time series: each add() appends a (time, file) entry and rewrites the .pvd
 /// atomically, so the collection stays valid if the run is killed between two steps.
