@@ -1,4 +1,4 @@
-// Drift of an oscillating cap (issue 14, "No drift"): a cap of polar angle a0 around +z on the unit
+// Drift of an oscillating cap: a cap of polar angle a0 around +z on the unit
 // sphere moves along its conormal with the normal speed s·cos(2πt/P), so its exact polar angle is
 //     a(t) = a0 + s·P/(2π)·sin(2πt/P),
 // periodic: after every period the cap is the initial one. Algorithm 1 is run stage by stage here
@@ -285,7 +285,7 @@ int main(int argc, char** argv) {
       "  --p1          plain P1 values at the feet of the characteristics (no gradient correction)\n"
       "  --linear-cut  cut at the linear zero of phi on each edge (no Hermite crossings)\n"
       "  --straight    distance to the polygon of interface edges (no curved interface)\n"
-      "  --face-slopes Hermite slopes from the averaged face gradients (the cut before issue 14's fix)\n"
+      "  --face-slopes Hermite slopes from the averaged face gradients (the cut's earlier slopes)\n"
       "  --hausd       the remesher's hausd (default: its own, diagonal / 1000)\n"
       "  --verbose     per step: the interface vertices the remesh keeps, moves or adds\n"
       "  --static      the remesher alone: 100 cuts of the exact distance to a circle moving by +-0.3 h\n"

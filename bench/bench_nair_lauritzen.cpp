@@ -1,4 +1,4 @@
-// The deformational flow of Nair & Lauritzen (2010) on the unit sphere (issue 14, "No drift"):
+// The deformational flow of Nair & Lauritzen (2010) on the unit sphere (no drift):
 // two caps of radius 0.4 (the paper's bells have 1/2, which leaves a gap of 0.047 rad between them:
 // under one edge at these sizes, so the cut merges them) centred on the equator at longitudes 5π/6 and 7π/6 are carried by the
 // prescribed flow (plugin `prescribed`, case 4 by default: deformation plus a solid-body rotation)

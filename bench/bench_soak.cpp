@@ -1,4 +1,4 @@
-// Soak (issue 14): thousands of iterations of a region that splits and merges twice per period
+// Soak: thousands of iterations of a region that splits and merges twice per period
 // (bench/soak_case.hpp: two overlapping caps, the conormal model with a periodic speed), with
 // everything that could drift over a long run recorded per iteration: |G| against the exact
 // solution, the components of G, the faces, the worst triangle and the share below quality 0.3,

@@ -1,5 +1,5 @@
 #pragma once
-// The soak case (issue 14): two caps of polar angle a = 55° on the unit sphere, their axes 90°
+// The soak case: two caps of polar angle a = 55° on the unit sphere, their axes 90°
 // apart, so they overlap and G(0) is one region. The conormal model with a periodic speed
 // (period P, phase 90°) moves the front by S(t) = −(δ/2)(1 − cos 2πt/P) ∈ [−δ, 0]: G shrinks by
 // δ and grows back, every period. With δ = 0.7 rad (40°) the neck of G is eroded away, G splits

@@ -291,7 +291,7 @@ END {
     }
     printf "![%s: ms per iteration against faces](images/performance_%s.png)\n\n", c, c
   }
-  # The goals of issue 13.
+  # The goals of the benchmark suite (docs/performance.md).
   printf "### Goals\n\n| case | size | threads | ms per iteration | goal | peak RSS MiB | goal | met |\n|---|---|---|---|---|---|---|---|\n"
   ngoal = split("conormal 1M 1500 1024|fire 233k 1000 -", goal, "|")
   for (g = 1; g <= ngoal; g++) {

@@ -1,4 +1,4 @@
-// No drift (issue 14): a cap oscillating along its conormal comes back to its area every period,
+// No drift: a cap oscillating along its conormal comes back to its area every period,
 // and the deformational flow of Nair & Lauritzen (2010) brings two caps back to where they started
 // (docs/validation/drift.md, docs/validation/nair_lauritzen.md).
 #include <bodyfit/app/case_config.hpp>

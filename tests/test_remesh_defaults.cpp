@@ -1,4 +1,4 @@
-// Real meshes at the default options (issue 14): the stage commands and `run` share one set of
+// Real meshes at the default options: the stage commands and `run` share one set of
 // defaults, which respect the input — its resolution (RemeshOptions::hmax = resolution_length of the
 // input, not a fraction of the bounding box), its creases (a ridge must be a crease one ring out,
 // not a noisy dihedral angle) and the interface accuracy of the evolution (snap at 1e-3 of an edge).

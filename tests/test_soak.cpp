@@ -1,4 +1,4 @@
-// The soak of issue 14, short: two overlapping caps go in and out once per period (conormal model
+// The soak, short: two overlapping caps go in and out once per period (conormal model
 // with a periodic speed, bench/soak_case.hpp), splitting and merging twice per period, for a few
 // hundred iterations at a coarse size. Every bound comes from an argument, not from this run's
 // figures (docs/validation/drift.md has those): the exact area where it is known, give or take

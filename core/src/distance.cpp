@@ -198,108 +198,132 @@ struct MarchWorkspace {
   }
 };
 
-/// Exact initialisation next to the seeds, then fast marching up to options.narrow_band. The result
-/// is in w.dist / w.state (accepted = 3) for the vertices of w.touched.
-void march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options, MarchWorkspace& w,
-           DistanceReport& report) {
-  const std::size_t nv = m.nv;
-  w.prepare(nv, seeds.faces.size());
-  std::vector<double>& dist = w.dist;
-  // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's when
-  // it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
-  const bool track = options.front_curvature && !seeds.bends.empty();
-  std::vector<double>& kappa = w.kappa;
-  const std::vector<double> gauss = track ? gaussian_curvature(m) : std::vector<double>();
-  std::vector<std::uint8_t>& state = w.state;
-  report.has_interface = !seeds.faces.empty();
+/// One march: the exact initialisation next to the seeds, then fast marching up to
+/// options.narrow_band, into the workspace (w.dist / w.state, accepted = 3, for w.touched).
+class FastMarch {
+ public:
+  FastMarch(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options, MarchWorkspace& w)
+      : m_(m), seeds_(seeds), options_(options), w_(w), dist_(w.dist), kappa_(w.kappa), state_(w.state),
+        // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's
+        // when it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
+        track_(options.front_curvature && !seeds.bends.empty()),
+        gauss_(track_ ? gaussian_curvature(m) : std::vector<double>()) {}
 
-  // Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
-  // segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
-  // this differs from the geodesic distance by O(h³), far below the O(h²) of the P1 zero set.
-  // The vertices up to kNearRings rings further get the same direct distance: final where it is
-  // below kNearRadius shortest edges (every interface point that close lies in a seed face within
-  // those rings), tentative beyond. This keeps the near field second-order accurate.
-  std::vector<int>& stamp = w.stamp;
-  const int base = w.stamp_base;
-  w.stamp_base += int(seeds.faces.size());
-  std::vector<int> ring;
-  for (std::size_t i = 0; i < seeds.faces.size(); ++i) {
-    const int f = seeds.faces[i];
-    const int mark = base + int(i);
-    ring.clear();
-    for (int c = 0; c < 3; ++c) {
-      const int u = m.corner_vertex[3 * f + c];
-      stamp[u] = mark;
-      ring.push_back(u);
-      if (state[u] == 0 && dist[u] == kInf) w.touched.push_back(u);
-      state[u] = 2;
-    }
-    for (int depth = 0, begin = 0; depth < kNearRings; ++depth) {
-      const int end = int(ring.size());
-      for (int r = begin; r < end; ++r)
-        for (int j = m.fan_start[ring[r]]; j < m.fan_start[ring[r] + 1]; ++j)
-          for (int x : {m.fan[j].a, m.fan[j].b})
-            if (stamp[x] != mark) {
-              stamp[x] = mark;
-              ring.push_back(x);
-            }
-      begin = end;
-    }
-    for (int x : ring) {
-      const Vec3& p = m.points[x];
-      double best = dist[x];
-      int best_segment = -1;
-      for (int k = seeds.seg_start[i]; k < seeds.seg_start[i + 1]; ++k) {
-        const auto& [a, b] = seeds.segments[k];
-        const double value = seeds.bends.empty()
-                                 ? point_segment_distance(p, a, b)
-                                 : point_arc_distance(p, a, b, seeds.bends[k].first, seeds.bends[k].second);
-        // On a tie (an interface vertex is also the end of its edges) an edge gives the curvature.
-        const bool point_so_far = best_segment >= 0 && seeds.segments[best_segment].first == seeds.segments[best_segment].second;
-        if (value < best || (value == best && point_so_far && a != b)) {
-          best = value;
-          best_segment = k;
-        }
+  /// Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
+  /// segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
+  /// this differs from the geodesic distance by O(h³), far below the O(h²) of the P1 zero set. The
+  /// vertices up to kNearRings rings further get the same direct distance: final where it is below
+  /// kNearRadius shortest edges (every interface point that close lies in a seed face within those
+  /// rings), tentative beyond. This keeps the near field second-order accurate.
+  void initialise() {
+    std::vector<int>& stamp = w_.stamp;
+    const int base = w_.stamp_base;
+    w_.stamp_base += int(seeds_.faces.size());
+    std::vector<int> ring;
+    for (std::size_t i = 0; i < seeds_.faces.size(); ++i) {
+      const int mark = base + int(i);
+      ring.clear();
+      for (int c = 0; c < 3; ++c) {
+        const int u = m_.corner_vertex[3 * seeds_.faces[i] + c];
+        stamp[u] = mark;
+        ring.push_back(u);
+        if (state_[u] == 0 && dist_[u] == kInf) w_.touched.push_back(u);
+        state_[u] = 2;
       }
-      if (best_segment < 0) continue;  // an earlier seed face was closer
-      w.set(x, best);
-      if (track) {
-        const auto& [a, b] = seeds.segments[best_segment];
-        const auto& [ka, kb] = seeds.bends[best_segment];
-        kappa[x] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss[x]);
+      for (int depth = 0, begin = 0; depth < kNearRings; ++depth) {
+        const int end = int(ring.size());
+        for (int r = begin; r < end; ++r)
+          for (int j = m_.fan_start[ring[r]]; j < m_.fan_start[ring[r] + 1]; ++j)
+            for (int x : {m_.fan[j].a, m_.fan[j].b})
+              if (stamp[x] != mark) {
+                stamp[x] = mark;
+                ring.push_back(x);
+              }
+        begin = end;
       }
+      for (int x : ring) set_nearest(x, i);
     }
   }
-  MinHeap heap;
-  // The initial heap: every vertex given a value so far (in touched), in index order so that the
-  // march does not depend on the order the seeds came in.
-  for (int v : seeds.zeros) w.set(v, 0.0);
-  std::vector<int> initial = w.touched;
-  std::sort(initial.begin(), initial.end());
-  for (int v : initial) {
-    if (dist[v] == kInf) continue;
-    if (state[v] == 0) {
-      double shortest = kInf;
-      for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
-        shortest = std::min(shortest, (m.points[m.fan[j].a] - m.points[v]).sqrnorm());
-      state[v] = dist[v] * dist[v] <= kNearRadius * kNearRadius * shortest ? 2 : 1;
+
+  /// Fast marching from every vertex given a value so far, up to options.narrow_band.
+  void run(DistanceReport& report) {
+    MinHeap heap = initial_heap(report);
+    while (!heap.empty()) {
+      const auto [d, v] = heap.top();
+      heap.pop();
+      if (state_[v] == 3 || d > dist_[v]) continue;
+      if (d > options_.narrow_band) break;
+      if (state_[v] == 1) ++report.marched;
+      state_[v] = 3;
+      accept(v, d, heap);
     }
-    if (state[v] == 2) ++report.initialised;
-    heap.emplace(dist[v], v);
   }
-  auto known = [&](int v) { return state[v] >= 2; };
-  // Update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
-  auto update = [&](const CornerGeometry& g, int a, int b, int x) {
-    if (!track) return FrontValue{triangle_update(g, dist[a], dist[b])};
-    return front_update(g, dist[a], dist[b], kappa[a], kappa[b], (gauss[a] + gauss[b] + gauss[x]) / 3);
-  };
-  auto split_update = [&](int split) {
-    const ObtuseSplit& s = m.splits[split];
+
+ private:
+  bool known(int v) const { return state_[v] >= 2; }
+
+  /// x's distance to the segments of seed face i when it is the nearest so far.
+  void set_nearest(int x, std::size_t i) {
+    const Vec3& p = m_.points[x];
+    double best = dist_[x];
+    int best_segment = -1;
+    for (int k = seeds_.seg_start[i]; k < seeds_.seg_start[i + 1]; ++k) {
+      const auto& [a, b] = seeds_.segments[k];
+      const double value = seeds_.bends.empty()
+                               ? point_segment_distance(p, a, b)
+                               : point_arc_distance(p, a, b, seeds_.bends[k].first, seeds_.bends[k].second);
+      // On a tie (an interface vertex is also the end of its edges) an edge gives the curvature.
+      const bool point_so_far =
+          best_segment >= 0 && seeds_.segments[best_segment].first == seeds_.segments[best_segment].second;
+      if (value < best || (value == best && point_so_far && a != b)) {
+        best = value;
+        best_segment = k;
+      }
+    }
+    if (best_segment < 0) return;  // an earlier seed face was closer
+    w_.set(x, best);
+    if (track_) {
+      const auto& [a, b] = seeds_.segments[best_segment];
+      const auto& [ka, kb] = seeds_.bends[best_segment];
+      kappa_[x] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss_[x]);
+    }
+  }
+
+  /// Every vertex given a value so far (in touched), in index order so that the march does not
+  /// depend on the order the seeds came in.
+  MinHeap initial_heap(DistanceReport& report) {
+    for (int v : seeds_.zeros) w_.set(v, 0.0);
+    std::vector<int> initial = w_.touched;
+    std::sort(initial.begin(), initial.end());
+    MinHeap heap;
+    for (int v : initial) {
+      if (dist_[v] == kInf) continue;
+      if (state_[v] == 0) {
+        double shortest = kInf;
+        for (int j = m_.fan_start[v]; j < m_.fan_start[v + 1]; ++j)
+          shortest = std::min(shortest, (m_.points[m_.fan[j].a] - m_.points[v]).sqrnorm());
+        state_[v] = dist_[v] * dist_[v] <= kNearRadius * kNearRadius * shortest ? 2 : 1;
+      }
+      if (state_[v] == 2) ++report.initialised;
+      heap.emplace(dist_[v], v);
+    }
+    return heap;
+  }
+
+  /// The update of x from the triangle (x; a, b).
+  FrontValue update(const CornerGeometry& g, int a, int b, int x) const {
+    if (!track_) return FrontValue{triangle_update(g, dist_[a], dist_[b])};
+    return front_update(g, dist_[a], dist_[b], kappa_[a], kappa_[b], (gauss_[a] + gauss_[b] + gauss_[x]) / 3);
+  }
+
+  /// The update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
+  FrontValue split_update(int split) const {
+    const ObtuseSplit& s = m_.splits[split];
     FrontValue value;
     if (!known(s.vertex)) return value;
     const int f = s.corner / 3, c = s.corner % 3;
-    const int x = m.corner_vertex[s.corner];
-    const int a = m.corner_vertex[3 * f + (c + 1) % 3], b = m.corner_vertex[3 * f + (c + 2) % 3];
+    const int x = m_.corner_vertex[s.corner];
+    const int a = m_.corner_vertex[3 * f + (c + 1) % 3], b = m_.corner_vertex[3 * f + (c + 2) % 3];
     if (known(a)) {
       const FrontValue first = update(s.first, a, s.vertex, x);
       if (first.d < value.d) value = first;
@@ -309,56 +333,71 @@ void march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options
       if (second.d < value.d) value = second;
     }
     return value;
-  };
-  while (!heap.empty()) {
-    const auto [d, v] = heap.top();
-    heap.pop();
-    if (state[v] == 3 || d > dist[v]) continue;
-    if (d > options.narrow_band) break;
-    if (state[v] == 1) ++report.marched;
-    state[v] = 3;
-    const Vec3& pv = m.points[v];
-    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j) {
-      const FanTriangle& t = m.fan[j];
+  }
+
+  void lower(int x, const FrontValue& value, MinHeap& heap) {
+    if (value.d < dist_[x]) {
+      w_.set(x, value.d);
+      kappa_[x] = value.kappa;
+      state_[x] = 1;
+      heap.emplace(value.d, x);
+    }
+  }
+
+  /// v accepted at d: its neighbours' tentative values lowered through the triangles around it.
+  void accept(int v, double d, MinHeap& heap) {
+    const Vec3& pv = m_.points[v];
+    for (int j = m_.fan_start[v]; j < m_.fan_start[v + 1]; ++j) {
+      const FanTriangle& t = m_.fan[j];
       for (int side = 0; side < 2; ++side) {
         const int x = side == 0 ? t.a : t.b;
         if (known(x)) continue;
         const int y = side == 0 ? t.b : t.a;
-        const Vec3& px = m.points[x];
+        const Vec3& px = m_.points[x];
         const Vec3 ev = pv - px;
         FrontValue value;
         if (!(t.obtuse & (1 << side))) {
-          if (known(y)) value = update(corner_geometry(ev, m.points[y] - px), v, y, x);
+          if (known(y)) value = update(corner_geometry(ev, m_.points[y] - px), v, y, x);
         } else {  // obtuse angle at x: the two acute virtual triangles of the unfolding
-          const int split = m.obtuse[3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3];
+          const int split = m_.obtuse[3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3];
           if (split >= 0) value = split_update(split);
         }
         if (value.d == kInf) {
           const double length = ev.norm();
-          value = {d + length, track ? carried_curvature(kappa[v], length, gauss[x]) : 0.0};
+          value = {d + length, track_ ? carried_curvature(kappa_[v], length, gauss_[x]) : 0.0};
         }
-        if (value.d < dist[x]) {
-          w.set(x, value.d);
-          kappa[x] = value.kappa;
-          state[x] = 1;
-          heap.emplace(value.d, x);
-        }
+        lower(x, value, heap);
       }
     }
     // v may be the unfolded vertex r of obtuse corners elsewhere: update those corners too.
-    for (int j = m.split_start[v]; j < m.split_start[v + 1]; ++j) {
-      const int split = m.split_list[j];
-      const int x = m.corner_vertex[m.splits[split].corner];
+    for (int j = m_.split_start[v]; j < m_.split_start[v + 1]; ++j) {
+      const int split = m_.split_list[j];
+      const int x = m_.corner_vertex[m_.splits[split].corner];
       if (known(x)) continue;
-      const FrontValue value = split_update(split);
-      if (value.d < dist[x]) {
-        w.set(x, value.d);
-        kappa[x] = value.kappa;
-        state[x] = 1;
-        heap.emplace(value.d, x);
-      }
+      lower(x, split_update(split), heap);
     }
   }
+
+  const FlatMesh& m_;
+  const Seeds& seeds_;
+  const DistanceOptions& options_;
+  MarchWorkspace& w_;
+  std::vector<double>& dist_;
+  std::vector<double>& kappa_;
+  std::vector<std::uint8_t>& state_;
+  const bool track_;
+  const std::vector<double> gauss_;
+};
+
+/// Exact initialisation next to the seeds, then fast marching up to options.narrow_band. The result
+/// is in w.dist / w.state (accepted = 3) for the vertices of w.touched.
+void march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options, MarchWorkspace& w,
+           DistanceReport& report) {
+  w.prepare(m.nv, seeds.faces.size());
+  report.has_interface = !seeds.faces.empty();
+  FastMarch march(m, seeds, options, w);
+  march.initialise();
+  march.run(report);
 }
 
 /// The signed result of a whole-mesh march: ±d where accepted within the band, ±∞ elsewhere.

@@ -102,6 +102,18 @@ struct LevelSetStep {
   StageTimes ms;
 };
 
+/// What the CFL sub-steps of one step on T^n share (Evolution::front_step): where they work and
+/// how far the front can go in one of them.
+struct FrontSubsteps {
+  bool in_band = true;            ///< near the front only (EvolutionOptions::narrow_band)
+  bool compose = false;           ///< characteristics composed back to T^n's φ (compose_substeps)
+  double traced_width = 0;        ///< the vertices traced: the front can reach them within a sub-step
+  double width = 0;               ///< where the traces read d and V
+  std::vector<int> band, traced;  ///< the vertices within width, and within traced_width, of the front
+  std::vector<int> everything;    ///< composed whole-surface sub-steps: every vertex (where V is known)
+  ScalarField next;               ///< φ at the end of the sub-step (in the band: the whole field)
+};
+
 class Evolution {
  public:
   Evolution(SurfaceMesh& mesh, VelocityModel& model, const EvolutionOptions& options, const RunState& start,
@@ -213,90 +225,108 @@ class Evolution {
   LevelSetStep front_step(double dt, int attempt) {
     LevelSetStep step;
     Stopwatch clock;
-    const bool in_band = options_.narrow_band;
-    DistanceOptions redistancing = options_.distance;
-    redistancing.keep_crossings = options_.keep_crossings;
-    if (!solver_) solver_.emplace(mesh_);
-    DistanceSolver& solver = *solver_;  // T^n's flat arrays, for every sub-step
+    if (!solver_) solver_.emplace(mesh_);  // T^n's flat arrays, for every sub-step
     Advector advector(mesh_);
     StepGeometry geometry;
-    const double cap = options_.max_cfl * cfl_length();
-    const double longest = edge_length_stats(mesh_).max;
-    // The front cannot reach further within a sub-step, and the cut reads φ two rings beyond the
-    // vertices of its crossed edges (DiscretizeOptions::fitted_slopes): 3 edges, not 2.
-    const double traced_width = cap + 3 * longest;
-    const double width = traced_width + cap + 2 * longest;  // where the traces read d and V
-    ScalarField phi = distance_, next;
-    std::vector<int> band = within(phi, width), traced;
-    if (in_band) next = phi;
-    const bool compose = options_.compose_substeps;
-    const AdvectionOptions& advection = options_.advection;
-    std::vector<int> everything;  // where composed whole-surface sub-steps know V
-    if (compose) {
-      advector.start_composition(phi);
-      if (!in_band) {
-        everything.resize(mesh_.n_vertices());
-        std::iota(everything.begin(), everything.end(), 0);
-      }
-    }
+    ScalarField phi = distance_;
+    FrontSubsteps f = front_substeps(phi, advector);
     step.ms.distance += clock.lap_ms();
     VectorField velocity;
     while (step.done < dt) {
       const double remaining = dt - step.done;
       if (step.substeps > 0) {  // φ: the advected one, redistanced around its zero set
-        if (in_band) {
-          std::vector<int> moved = solver.redistance(phi, width, traced, nullptr, redistancing);
-          // Leaving the band: |φ| ≥ width with its sign, so that φ stays a distance clamped there.
-          for (int v : band)
-            if (!std::binary_search(moved.begin(), moved.end(), v)) phi[v] = next[v] = std::copysign(width, phi[v]);
-          for (int v : moved) next[v] = phi[v];
-          band = std::move(moved);
-        } else {
-          phi = solver.signed_distance(phi, redistancing);
-          band = within(phi, width);
-        }
+        redistance_front(f, phi);
         step.ms.distance += clock.lap_ms();
-        if (band.empty()) break;  // G vanished or fills S within the step
+        if (f.band.empty()) break;  // G vanished or fills S within the step
       }
+      const std::span<const int> active = f.in_band ? std::span<const int>(f.band) : std::span<const int>();
       if (step.substeps == 0) {
         velocity = first_velocity(step, dt, attempt, clock, &geometry);
       } else {
-        const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining, in_band ? band : std::span<const int>(), &geometry);
+        const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining, active, &geometry);
         const VelocityField field = model_.compute(context);
-        velocity_into(field, context, model_.name(), in_band ? band : std::span<const int>(), velocity);
+        velocity_into(field, context, model_.name(), active, velocity);
         step.ms.velocity += clock.lap_ms();
       }
       // The vertices the front can reach within a sub-step: traced, and their speed sizes it (a
       // characteristic from further away must cross them, which takes longer than the sub-step).
-      traced.clear();
-      for (int v : band)
-        if (std::abs(phi[v]) <= traced_width) traced.push_back(v);
-      const double sub = substep_length(velocity, traced, remaining, step.substeps);
-      if (in_band) {
-        AdvectionReport report;
-        if (compose)
-          advector.advect_band_composed(phi, velocity, sub, traced, band, next, advection, &report);
-        else
-          advector.advect_band(phi, velocity, sub, traced, band, next, advection, &report);
-        check_report(report);
-        model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt, traced});
-        for (int v : traced) phi[v] = next[v];
-        advance_substep(step, sub, remaining, dt);
-      } else if (compose) {
-        AdvectionReport report;
-        next = phi;  // as in the band: only the vertices the front can reach are traced
-        advector.advect_band_composed(phi, velocity, sub, traced, everything, next, advection, &report);
-        check_report(report);
-        model_.end_step(StepOutcome{mesh_, phi, next, t_ + step.done, sub, attempt});
-        advance_substep(step, sub, remaining, dt);
-        std::swap(phi, next);
-      } else {
-        phi = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
-      }
+      f.traced.clear();
+      for (int v : f.band)
+        if (std::abs(phi[v]) <= f.traced_width) f.traced.push_back(v);
+      const double sub = substep_length(velocity, f.traced, remaining, step.substeps);
+      advect_front(f, advector, phi, velocity, sub, remaining, dt, attempt, step);
       step.ms.advect += clock.lap_ms();
     }
     step.phi_next = std::move(phi);
     return step;
+  }
+
+  /// The sub-steps' widths and first band on T^n (and the composition's start at φ^n).
+  FrontSubsteps front_substeps(const ScalarField& phi, Advector& advector) const {
+    FrontSubsteps f;
+    f.in_band = options_.narrow_band;
+    f.compose = options_.compose_substeps;
+    const double cap = options_.max_cfl * cfl_length();
+    const double longest = edge_length_stats(mesh_).max;
+    // The front cannot reach further within a sub-step, and the cut reads φ two rings beyond the
+    // vertices of its crossed edges (DiscretizeOptions::fitted_slopes): 3 edges, not 2.
+    f.traced_width = cap + 3 * longest;
+    f.width = f.traced_width + cap + 2 * longest;
+    f.band = within(phi, f.width);
+    if (f.in_band) f.next = phi;
+    if (f.compose) {
+      advector.start_composition(phi);
+      if (!f.in_band) {
+        f.everything.resize(mesh_.n_vertices());
+        std::iota(f.everything.begin(), f.everything.end(), 0);
+      }
+    }
+    return f;
+  }
+
+  /// φ redistanced around its zero set: in the band (the vertices leaving it keep ±width), or on
+  /// the whole surface.
+  void redistance_front(FrontSubsteps& f, ScalarField& phi) {
+    DistanceOptions redistancing = options_.distance;
+    redistancing.keep_crossings = options_.keep_crossings;
+    if (!f.in_band) {
+      phi = solver_->signed_distance(phi, redistancing);
+      f.band = within(phi, f.width);
+      return;
+    }
+    std::vector<int> moved = solver_->redistance(phi, f.width, f.traced, nullptr, redistancing);
+    // Leaving the band: |φ| ≥ width with its sign, so that φ stays a distance clamped there.
+    for (int v : f.band)
+      if (!std::binary_search(moved.begin(), moved.end(), v)) phi[v] = f.next[v] = std::copysign(f.width, phi[v]);
+    for (int v : moved) f.next[v] = phi[v];
+    f.band = std::move(moved);
+  }
+
+  /// One sub-step of `sub` advecting φ: the traced vertices in the band; or on the whole surface,
+  /// composed back to T^n or not.
+  void advect_front(FrontSubsteps& f, Advector& advector, ScalarField& phi, const VectorField& velocity, double sub,
+                    double remaining, double dt, int attempt, LevelSetStep& step) {
+    if (!f.in_band && !f.compose) {
+      phi = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
+      return;
+    }
+    const AdvectionOptions& advection = options_.advection;
+    AdvectionReport report;
+    if (!f.in_band) f.next = phi;  // as in the band: only the vertices the front can reach are traced
+    const std::vector<int>& known = f.in_band ? f.band : f.everything;  // where V is known
+    if (f.compose)
+      advector.advect_band_composed(phi, velocity, sub, f.traced, known, f.next, advection, &report);
+    else
+      advector.advect_band(phi, velocity, sub, f.traced, known, f.next, advection, &report);
+    check_report(report);
+    if (f.in_band) {
+      model_.end_step(StepOutcome{mesh_, phi, f.next, t_ + step.done, sub, attempt, f.traced});
+      for (int v : f.traced) phi[v] = f.next[v];
+    } else {
+      model_.end_step(StepOutcome{mesh_, phi, f.next, t_ + step.done, sub, attempt});
+      std::swap(phi, f.next);
+    }
+    advance_substep(step, sub, remaining, dt);
   }
 
   /// V^n on T^n with d^n, over the whole surface (the state's outputs show it); a retried step

@@ -405,37 +405,21 @@ std::size_t remove_detached(SurfaceMesh& mesh, ScalarField& value, std::span<con
   return detached.size();
 }
 
-}  // namespace
-
-DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options) {
-  DiscretizeReport report;
-  if (phi.size() != mesh.n_vertices())
-    throw InputError("discretize: the level set has " + std::to_string(phi.size()) + " values for " +
-                     std::to_string(mesh.n_vertices()) + " vertices");
-  ScalarField value = phi;
-  if (!options.grown_from.empty() && options.grown_from.size() != mesh.n_vertices())
-    throw InputError("discretize: grown_from has " + std::to_string(options.grown_from.size()) + " values for " +
-                     std::to_string(mesh.n_vertices()) + " vertices");
-  const double h_input = options.speck_area > 0 || !options.grown_from.empty() ? edge_length_stats(mesh).mean : 0;
-  // Vertices that may end up on the level set: the input's zeros and the ends of crossed edges
-  // (snapped); the cut adds its new vertices. The faces around them are the speck search's seeds.
-  std::vector<VertexHandle> may_be_zero;
-  for (auto v : mesh.vertices()) {
-    if (!std::isfinite(value[v.idx()]))
-      throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
-    if (value[v.idx()] == 0) may_be_zero.push_back(v);
-  }
-
-  // Crossed edges: the input's, less those a snap removed, plus those around separated vertices.
+/// The edges the zero level set crosses, once the crossings that nearly touch a vertex are snapped
+/// and pinched vertices separated. With `find_parts`, the ends of the input's crossed edges join
+/// `may_be_zero` (a snap may put them on the level set).
+std::vector<EdgeHandle> crossed_edges(SurfaceMesh& mesh, ScalarField& value, const DiscretizeOptions& options,
+                                      bool find_parts, std::vector<VertexHandle>& may_be_zero,
+                                      DiscretizeReport& report) {
   std::vector<EdgeHandle> crossed;
   for (auto e : mesh.edges())
     if (crossed_edge(mesh, value, e)) crossed.push_back(e);
-  const bool find_parts = options.speck_area > 0 || !options.grown_from.empty();
   if (find_parts)
     for (auto e : crossed)
       for (int side = 0; side < 2; ++side) may_be_zero.push_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)));
   snap(mesh, crossed, value, options, report);
   auto separated = separate_pinches(mesh, value, report);
+  // The input's, less those a snap removed, plus those around separated vertices.
   std::erase_if(crossed, [&](EdgeHandle e) { return !crossed_edge(mesh, value, e); });
   if (!separated.empty()) {
     for (auto v : separated)
@@ -444,8 +428,13 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     std::sort(crossed.begin(), crossed.end());
     crossed.erase(std::unique(crossed.begin(), crossed.end()), crossed.end());
   }
+  return crossed;
+}
 
-  // Faces cut into a triangle and a quad, found on the unsplit mesh.
+/// The faces the level set cuts into a triangle and a quad, found on the unsplit mesh (and every
+/// cut face counted).
+std::vector<QuadCut> cut_quads(const SurfaceMesh& mesh, const ScalarField& value, const std::vector<EdgeHandle>& crossed,
+                               DiscretizeReport& report) {
   std::vector<QuadCut> quads;
   for (auto e : crossed)
     for (int side = 0; side < 2; ++side) {
@@ -464,25 +453,22 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
         quads.push_back({a, b, c, e.idx(), mesh.edge_handle(mesh.next_halfedge_handle(hc)).idx()});
       }
     }
-  report.crossed_edges = crossed.size();
+  return quads;
+}
 
-  // Split every crossed edge at the zero of the linear interpolant.
-  // The i-th crossed edge (in index order) gets the vertex first_crossing + i.
-  const int first_crossing = int(mesh.n_vertices());
-  auto crossing = [&](int edge_index) {
-    auto it = std::lower_bound(crossed.begin(), crossed.end(), EdgeHandle(edge_index));
-    return VertexHandle(first_crossing + int(it - crossed.begin()));
-  };
-  // Vertex gradients of the input φ at the ends of the crossed edges (computed before any split).
-  std::vector<std::pair<int, Vec3>> gradient_at;
-  if (options.hermite_crossings) {
+/// The gradients of the input φ at the ends of the crossed edges (computed before any split): the
+/// slopes of the Hermite zeros, fitted on two rings where φ is smooth there.
+class CrossingSlopes {
+ public:
+  CrossingSlopes(const SurfaceMesh& mesh, const ScalarField& phi, const std::vector<EdgeHandle>& crossed,
+                 const DiscretizeOptions& options, DiscretizeReport& report) {
+    if (!options.hermite_crossings) return;
     for (auto e : crossed)
-      for (int side = 0; side < 2; ++side) gradient_at.emplace_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)).idx(), Vec3());
-    std::sort(gradient_at.begin(), gradient_at.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-    gradient_at.erase(std::unique(gradient_at.begin(), gradient_at.end(),
-                                  [](const auto& x, const auto& y) { return x.first == y.first; }),
-                      gradient_at.end());
-    for (auto& [v, g] : gradient_at) {
+      for (int side = 0; side < 2; ++side) at_.emplace_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)).idx(), Vec3());
+    std::sort(at_.begin(), at_.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    at_.erase(std::unique(at_.begin(), at_.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+              at_.end());
+    for (auto& [v, g] : at_) {
       std::optional<Vec3> fitted;
       if (options.fitted_slopes) {
         fitted = fitted_gradient(mesh, VertexHandle(v), phi, options.fit_residual_limit);
@@ -491,11 +477,19 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
       g = fitted ? *fitted : vertex_gradient(mesh, VertexHandle(v), phi);
     }
   }
-  auto slope_of = [&](VertexHandle v) {
-    auto it = std::lower_bound(gradient_at.begin(), gradient_at.end(), v.idx(),
-                               [](const auto& x, int key) { return x.first < key; });
+  const Vec3& operator()(VertexHandle v) const {
+    auto it = std::lower_bound(at_.begin(), at_.end(), v.idx(), [](const auto& x, int key) { return x.first < key; });
     return it->second;
-  };
+  }
+
+ private:
+  std::vector<std::pair<int, Vec3>> at_;
+};
+
+/// Split every crossed edge at the zero of φ on it (Hermite or linear): the i-th crossed edge (in
+/// index order) gets the vertex n_vertices + i, with φ = 0.
+void split_crossed_edges(SurfaceMesh& mesh, ScalarField& value, const std::vector<EdgeHandle>& crossed,
+                         const CrossingSlopes& slope_of, const DiscretizeOptions& options) {
   value.reserve(value.size() + crossed.size());
   for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
@@ -520,13 +514,10 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
       set_edge_tags(mesh, mesh.edge_handle(ph), w == a || w == b ? tags : EdgeTags{});
     }
   }
-  report.inserted_vertices = crossed.size();
+}
 
-  for (const auto& quad : quads)
-    if (improve_diagonal(mesh, crossing(quad.edge_ab), quad.b, quad.c, crossing(quad.edge_ca)))
-      ++report.flipped_diagonals;
-
-  // Every face now lies on one side: inside when a vertex is negative.
+/// Every face lies on one side once the crossed edges are split: inside when a vertex is negative.
+void label_faces(SurfaceMesh& mesh, const ScalarField& value) {
   for (auto f : mesh.faces()) {
     auto h = mesh.halfedge_handle(f);
     auto h1 = mesh.next_halfedge_handle(h);
@@ -534,23 +525,11 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
                   value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
   }
-  if (find_parts) {
-    std::vector<FaceHandle> seeds;
-    auto seed_around = [&](VertexHandle v) {
-      if (value[v.idx()] == 0)
-        for (auto f : mesh.vf_range(v)) seeds.push_back(f);
-    };
-    for (auto v : may_be_zero) seed_around(v);
-    for (int v = first_crossing; v < int(mesh.n_vertices()); ++v) seed_around(VertexHandle(v));
-    if (!options.grown_from.empty()) report.removed_detached = remove_detached(mesh, value, options.grown_from, seeds, 1e-12 * h_input);
-    if (options.speck_area > 0)
-      report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
-  }
-  for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
-  for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
+}
 
-  // The interface: exactly the edges between faces of different labels (as
-  // update_interface_from_regions), counting interface edges per vertex as a self-check.
+/// The interface: exactly the edges between faces of different labels (as
+/// update_interface_from_regions), counting interface edges per vertex as a self-check.
+void tag_interface(SurfaceMesh& mesh, DiscretizeReport& report) {
   std::vector<VertexHandle> interface_vertices;
   std::vector<unsigned char> degree;
   for (auto e : mesh.edges()) {
@@ -570,13 +549,72 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   }
   for (auto v : interface_vertices)
     if (!acceptable_degree(mesh, v, degree[v.idx()])) ++report.pinched_vertices;
+}
 
+/// Garbage-collect the elements the snaps and the separations deleted, if any.
+void collect_deleted(SurfaceMesh& mesh) {
   bool has_deleted = false;
   for (std::size_t i = 0; i < mesh.n_faces() && !has_deleted; ++i) has_deleted = mesh.status(FaceHandle(int(i))).deleted();
   for (std::size_t i = 0; i < mesh.n_edges() && !has_deleted; ++i) has_deleted = mesh.status(EdgeHandle(int(i))).deleted();
   for (std::size_t i = 0; i < mesh.n_vertices() && !has_deleted; ++i)
     has_deleted = mesh.status(VertexHandle(int(i))).deleted();
   if (has_deleted) mesh.garbage_collection();
+}
+
+}  // namespace
+
+DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const DiscretizeOptions& options) {
+  DiscretizeReport report;
+  if (phi.size() != mesh.n_vertices())
+    throw InputError("discretize: the level set has " + std::to_string(phi.size()) + " values for " +
+                     std::to_string(mesh.n_vertices()) + " vertices");
+  ScalarField value = phi;
+  if (!options.grown_from.empty() && options.grown_from.size() != mesh.n_vertices())
+    throw InputError("discretize: grown_from has " + std::to_string(options.grown_from.size()) + " values for " +
+                     std::to_string(mesh.n_vertices()) + " vertices");
+  const double h_input = options.speck_area > 0 || !options.grown_from.empty() ? edge_length_stats(mesh).mean : 0;
+  // Vertices that may end up on the level set: the input's zeros and the ends of crossed edges
+  // (snapped); the cut adds its new vertices. The faces around them are the speck search's seeds.
+  std::vector<VertexHandle> may_be_zero;
+  for (auto v : mesh.vertices()) {
+    if (!std::isfinite(value[v.idx()]))
+      throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
+    if (value[v.idx()] == 0) may_be_zero.push_back(v);
+  }
+
+  const bool find_parts = options.speck_area > 0 || !options.grown_from.empty();
+  const std::vector<EdgeHandle> crossed = crossed_edges(mesh, value, options, find_parts, may_be_zero, report);
+  const std::vector<QuadCut> quads = cut_quads(mesh, value, crossed, report);
+  report.crossed_edges = crossed.size();
+
+  const int first_crossing = int(mesh.n_vertices());
+  split_crossed_edges(mesh, value, crossed, CrossingSlopes(mesh, phi, crossed, options, report), options);
+  report.inserted_vertices = crossed.size();
+  auto crossing = [&](int edge_index) {
+    auto it = std::lower_bound(crossed.begin(), crossed.end(), EdgeHandle(edge_index));
+    return VertexHandle(first_crossing + int(it - crossed.begin()));
+  };
+  for (const auto& quad : quads)
+    if (improve_diagonal(mesh, crossing(quad.edge_ab), quad.b, quad.c, crossing(quad.edge_ca)))
+      ++report.flipped_diagonals;
+
+  label_faces(mesh, value);
+  if (find_parts) {
+    std::vector<FaceHandle> seeds;
+    auto seed_around = [&](VertexHandle v) {
+      if (value[v.idx()] == 0)
+        for (auto f : mesh.vf_range(v)) seeds.push_back(f);
+    };
+    for (auto v : may_be_zero) seed_around(v);
+    for (int v = first_crossing; v < int(mesh.n_vertices()); ++v) seed_around(VertexHandle(v));
+    if (!options.grown_from.empty()) report.removed_detached = remove_detached(mesh, value, options.grown_from, seeds, 1e-12 * h_input);
+    if (options.speck_area > 0)
+      report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
+  }
+  for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
+  for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
+  tag_interface(mesh, report);
+  collect_deleted(mesh);
   return report;
 }
 

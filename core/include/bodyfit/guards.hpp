@@ -1,5 +1,5 @@
 #pragma once
-// The checks every entry point shares (issue 14): the budget of faces a command may build, the
+// The checks every entry point shares: the budget of faces a command may build, the
 // budget of sub-steps an advection may take, and finiteness of fields. One place, so a command,
 // a case and a stage refuse the same things with the same words.
 //
