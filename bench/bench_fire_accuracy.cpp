@@ -1,5 +1,5 @@
 // Accuracy and cost of the fire cases' CFL sub-steps: the narrow band against the whole surface
-// and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/performance.md).
+// and against a reference with 4× more sub-steps (EvolutionOptions::narrow_band, docs/validation/performance.md).
 //
 //   bench_fire_accuracy [--case meshes/cases/fire_four_disks.toml] [--h H] [--set key=value]...
 //                       [--iterations N] [--reference-factor 4] [--reference-hmax 1]

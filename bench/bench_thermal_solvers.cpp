@@ -1,4 +1,4 @@
-// Benchmark of the thermal model's numerical core (plugins/thermal, docs/thermal_solvers.md): TetGen,
+// Benchmark of the thermal model's numerical core (plugins/thermal, docs/validation/thermal_solvers.md): TetGen,
 // assembly, and the linear solvers on the state + adjoint of a unit ball whose skin is cooled on a
 // polar cap G (κ = h_ε(d), ε = 2h by default, d the distance along the sphere to the cap's circle).
 //

@@ -56,7 +56,7 @@ if(BODYFIT_WITH_CAIRO)
 endif()
 message(STATUS "bodyfit: fire maps through Cairo: ${BODYFIT_HAVE_CAIRO}")
 # MPI is optional: `bodyfit ensemble` spreads members over ranks through a module loaded only
-# under an MPI launcher (core/mpi), never linked into the core or the program.
+# under an MPI launcher (app/mpi), never linked into the core or the program.
 set(BODYFIT_HAVE_MPI OFF)
 if(BODYFIT_WITH_MPI)
   set(MPI_CXX_SKIP_MPICXX TRUE)  # the C API from C++, not the removed C++ bindings

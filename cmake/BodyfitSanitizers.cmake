@@ -1,5 +1,5 @@
 # Sanitizers and fuzzers: build options for a separate build directory (scripts/run_tests.sh uses
-# build-sanitize/ with clang; docs/testing.md).
+# build-sanitize/ with clang; docs/reference/testing.md).
 #
 # BODYFIT_SANITIZE=address,undefined instruments every target of the project. UBSan halts at the
 # first error (-fno-sanitize-recover=all), so a test sees it as a failure; the stack traces need

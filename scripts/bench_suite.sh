@@ -9,8 +9,8 @@
 # performance.md (the report: tables, fitted growth exponents, 1 → 2 thread speed-ups, the goals),
 # images/performance_<case>.png (ms per iteration against faces, log-log, one line per stage) and
 # runs/<case>_<size>_t<threads>/ (each run's history.csv, log and time). Unless --quick or --no-docs,
-# the report also replaces the part of docs/performance.md between its bench_suite markers, and the
-# plots go to docs/images/.
+# the report also replaces the part of docs/validation/performance.md between its bench_suite markers, and the
+# plots go to docs/validation/images/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -28,7 +28,7 @@ usage: scripts/bench_suite.sh [--quick] [--large] [--sizes 60k,1M,...] [--cases 
   --max-seconds  stop a run after S seconds and record it as timed out (default 1800)
   --out          output directory (default <build>/bench_suite)
   --build        build directory with bin/bodyfit (default $BODYFIT_BUILD_DIR or build/)
-  --no-docs      do not update docs/performance.md and docs/images/performance_*.png
+  --no-docs      do not update docs/validation/performance.md and docs/validation/images/performance_*.png
 Sizes (faces of T^0) and mesh sizes h (--set surface.h=h --set remesh.hmax=h):
   conormal  60k 0.0216, 120k 0.0153, 240k 0.0108, 1M 0.0054, 4M 0.0027 (remesh.hmin = h/10)
   fire      54k 386 m, 233k 194 m, 1M 97 m
@@ -291,7 +291,7 @@ END {
     }
     printf "![%s: ms per iteration against faces](images/performance_%s.png)\n\n", c, c
   }
-  # The goals of the benchmark suite (docs/performance.md).
+  # The goals of the benchmark suite (docs/validation/performance.md).
   printf "### Goals\n\n| case | size | threads | ms per iteration | goal | peak RSS MiB | goal | met |\n|---|---|---|---|---|---|---|---|\n"
   ngoal = split("conormal 1M 1500 1024|fire 233k 1000 -", goal, "|")
   for (g = 1; g <= ngoal; g++) {
@@ -327,7 +327,7 @@ AWK
 echo "wrote $csv, $out/performance.md and $out/images/"
 
 if ((docs)); then
-  doc="$ROOT/docs/performance.md"
+  doc="$ROOT/docs/validation/performance.md"
   begin='<!-- bench_suite:begin -->' end='<!-- bench_suite:end -->'
   if ! grep -qF "$begin" "$doc" 2>/dev/null || ! grep -qF "$end" "$doc"; then
     echo "bench_suite.sh: $doc has no $begin ... $end markers; left alone" >&2
@@ -338,7 +338,7 @@ if ((docs)); then
     $0 == end { skip = 0 }
     !skip' "$doc" > "$doc.tmp" && mv "$doc.tmp" "$doc"
   for c in ${cases//,/ }; do
-    [[ ! -f "$out/images/performance_$c.png" ]] || cp "$out/images/performance_$c.png" "$ROOT/docs/images/"
+    [[ ! -f "$out/images/performance_$c.png" ]] || cp "$out/images/performance_$c.png" "$ROOT/docs/validation/images/"
   done
-  echo "updated $doc and docs/images/performance_*.png"
+  echo "updated $doc and docs/validation/images/performance_*.png"
 fi

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Run the libFuzzer targets of tests/fuzz (built with BODYFIT_BUILD_FUZZERS, see docs/testing.md)
+# Run the libFuzzer targets of tests/fuzz (built with BODYFIT_BUILD_FUZZERS, see docs/reference/testing.md)
 # for a bounded time each, from their seed corpora. A crash, a sanitizer report, a leak, an
 # exception other than InputError or an input slower than --timeout fails the run; the input is
 # saved in the output directory (artifact_prefix) and named in the message. New corpus entries go

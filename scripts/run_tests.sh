@@ -5,7 +5,7 @@
 #             no benchmark programs, with the fuzz targets) and every test again, under the sanitizers;
 #   fuzz      each libFuzzer target of tests/fuzz for BODYFIT_FUZZ_SECONDS seconds (default 30) from
 #             its seed corpus (scripts/run_fuzzers.sh).
-# Any failure, sanitizer report or fuzzer finding fails the run. docs/testing.md has the details.
+# Any failure, sanitizer report or fuzzer finding fails the run. docs/reference/testing.md has the details.
 #   usage: scripts/run_tests.sh [--stages release,sanitize,fuzz]   (default: all three, what CI runs)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

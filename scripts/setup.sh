@@ -9,9 +9,10 @@ PACKAGES=(
   libopenblas0  # CHOLMOD's supernodal factorisation: 2.6x faster than with Debian's reference BLAS
   libfmt-dev libspdlog-dev doctest-dev libtomlplusplus-dev libcli11-dev libtbb-dev
   libpng-dev libgdal-dev
-  libcairo2-dev  # fire maps (core/map/, a module loaded on first use)
-  libopenmpi-dev openmpi-bin  # bodyfit ensemble on MPI ranks (the module core/mpi; mpirun in its test)
+  libcairo2-dev  # maps (app/map, a module loaded on first use)
+  libopenmpi-dev openmpi-bin  # bodyfit ensemble on MPI ranks (the module app/mpi; mpirun in its test)
   gdal-bin  # gdal_translate: the GeoTIFF test converts an .asc to .tif with it
+  python3  # scripts/docs.py: the manual's generated pages and figures (CTest docs_up_to_date)
   python3-vtk9 python3-meshio  # tests/test_io.cpp cross-checks VTU and Medit files (skipped when absent)
   clang libclang-rt-14-dev llvm  # the sanitize and fuzz stages of run_tests.sh: ASan/UBSan, libFuzzer, llvm-symbolizer
 )

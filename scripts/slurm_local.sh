@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A throw-away single-node SLURM cluster on this host, to try `srun`/`sbatch bodyfit ensemble`
-# and run the `ensemble_srun` test (docs/fire.md, "Ensembles"). Needs root (slurmd does) and
+# and run the `ensemble_srun` test (docs/reference/ensembles.md). Needs root (slurmd does) and
 # Debian's `slurm-wlm munge` packages. Nothing outside the state directory is touched: the munge
 # key, munged's socket, slurm.conf, the spool directories, the logs and the pid files all live in
 #   ${BODYFIT_SLURM_DIR:-${TMPDIR:-/tmp}/bodyfit-slurm}

@@ -7,7 +7,7 @@ set -euo pipefail
 source=$1 build=$2 work=$3
 rm -rf "$work"
 fail() { echo "FAILED: $*" >&2; exit 1; }
-docs_before=$(cksum < "$source/docs/performance.md")
+docs_before=$(cksum < "$source/docs/validation/performance.md")
 
 "$source/scripts/bench_suite.sh" --quick --build "$build" --out "$work"
 
@@ -24,5 +24,5 @@ for c in conormal fire; do
 done
 [[ $(grep -c '^Growth exponent' "$work/performance.md") -eq 2 ]] || fail "no exponent line per case in the report"
 grep -q '^| total | [0-9.-]* |' "$work/performance.md" || fail "no exponent of the total"
-[[ "$(cksum < "$source/docs/performance.md")" == "$docs_before" ]] || fail "--quick changed docs/performance.md"
+[[ "$(cksum < "$source/docs/validation/performance.md")" == "$docs_before" ]] || fail "--quick changed docs/validation/performance.md"
 echo "ok: $rows rows"

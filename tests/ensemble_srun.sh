@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `bodyfit ensemble` under a running SLURM (docs/fire.md, "Ensembles"): srun -n 2 writes the
+# `bodyfit ensemble` under a running SLURM (docs/reference/ensembles.md): srun -n 2 writes the
 # sequential run's bytes, so does the shipped batch script through sbatch, and srun --mpi=none is
 # refused before any task runs a member. Skipped (exit 77) without srun or a SLURM controller that
 # answers: scripts/slurm_local.sh start gives one on this host (root).

@@ -2,7 +2,7 @@
 # Out-of-tree plugin check: install the bodyfit build to a temporary prefix, build
 # examples/plugin against it with find_package(bodyfit) + bodyfit_add_plugin, then ask the
 # installed driver to list it through BODYFIT_PLUGIN_PATH. The example is configured as
-# docs/plugins.md says, with no build type: it must default to Release.
+# docs/guide/writing_models.md says, with no build type: it must default to Release.
 #   usage: out_of_tree_plugin.sh <bodyfit build dir> <bodyfit source dir>
 set -euo pipefail
 build=$(cd "$1" && pwd)

@@ -178,7 +178,7 @@ TEST_CASE("a speed that grows along the path: the midpoint's velocity is read in
   // face's affine V to a midpoint beyond its edges under-estimates a convex speed there, and a
   // trace starts at a vertex in whichever face of its fan the mesh names: the feet fell short by
   // 0.033–0.090 of a cell depending on e, and a fire's front lagged 3 % of its burnt area behind a
-  // reference with 16× the sub-steps (docs/fire.md). Read where it lies: 0.016–0.022.
+  // reference with 16× the sub-steps (docs/reference/fire_model.md). Read where it lies: 0.016–0.022.
   const int n = 40;
   const double h = 1.0 / n, L = 4 * h, T = 1.5 * h;
   const SurfaceMesh mesh = make_square(n);

@@ -1,5 +1,5 @@
 // Bad input at every entry point: one row per probe — the command, the exit code it must
-// end with (docs/running.md, "Exit codes"), a fragment of its message, and the output that must
+// end with (docs/reference/running.md, "Exit codes"), a fragment of its message, and the output that must
 // not exist afterwards (or must, for MMG's spellings that are aliases). Every refusal by estimate
 // (faces, sub-steps) happens before any heavy work, so the whole table runs in seconds.
 #include <bodyfit/error.hpp>

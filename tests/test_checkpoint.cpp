@@ -186,7 +186,7 @@ TEST_CASE("format 2 checkpoints (before the model state) and format 1 still load
   CHECK_FALSE(c2.model);
   check_same_arrays(c2.mesh, mesh);
 
-  // Format 1 (faces by corners), as session-1 runs wrote them: one triangle, one tagged edge.
+  // Format 1 (faces by corners), as the first bodyfit wrote them: one triangle, one tagged edge.
   std::string v1 = "BFCKPT01";
   auto put = [&](const auto& value) { v1.append(reinterpret_cast<const char*>(&value), sizeof value); };
   put(std::int64_t(3)), put(0.25), put(std::uint64_t(3)), put(std::uint64_t(1));

@@ -19,7 +19,7 @@ using namespace bodyfit;
 namespace {
 
 // Bounds from arguments, not from the runs' figures (docs/validation/drift.md, nair_lauritzen.md):
-// the criterion for the oscillating cap (within 1 % over 10 periods: 0.1 % per period);
+// the drift goal for the oscillating cap (within 1 % over 10 periods: 0.1 % per period);
 // elsewhere the resolution: a front within half an edge of the exact one moves |G| by at most
 // |∂G|·h/2; and a front that came back is within a few edges of where it started (three here),
 // a cap lost or merged with the other would be ~0.4 away.

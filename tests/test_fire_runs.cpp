@@ -217,7 +217,7 @@ TEST_CASE("many sub-steps: the head runs as the exact solution, the back at R0 (
   // Where R + R'' < 0 at the head, the exact head is a corner of the Wulff shape and runs well short
   // of R(alpha). V = R n_Σ (front_velocity = "normal") turns with n_Σ over a sub-step and put the
   // head 16 % ahead of the exact front here (5 % with composed sub-steps); V = R n_Σ + (dR/dθ) t, the
-  // front's characteristic velocity, puts it within 0.2 % (docs/fire.md, "Huygens' velocity"). The
+  // front's characteristic velocity, puts it within 0.2 % (docs/reference/fire_model.md, "Huygens' velocity"). The
   // back runs at R0 and moves 1/25 of an edge per sub-step: redistancing that re-placed the zero
   // set every sub-step (keep_crossings = false) moved that slow front by O(h^2 kappa) each time,
   // 2 % of its motion, against 0.03 % with the crossings kept.
@@ -285,7 +285,7 @@ TEST_CASE("CFL sub-steps converge: max_cfl 4 and max_cfl 1 give the same front")
   // Steep bumpy ground and a cross wind: R changes along the front and with its direction, from
   // R0 on the flanks to many times it uphill. Redistancing re-placed the zero set by O(h^2 kappa)
   // every sub-step, which added up with their number (EvolutionOptions::keep_crossings): max_cfl 4
-  // and 1 then burnt areas 13 % apart on the four-fire case (docs/fire.md, "Sub-steps").
+  // and 1 then burnt areas 13 % apart on the four-fire case (docs/validation/advection.md, "Sub-steps that converge").
   const double h = 20;
   const HeightGrid grid = bumpy_ground(h, 200);
   const std::string model = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
@@ -515,7 +515,7 @@ TEST_CASE("[model] file names are relative to the case file: a run from another 
   INFO(first.output);
   CHECK(first.exit_code == 0);
   CHECK(fs::exists(dir / "elsewhere" / "out" / (config::have_gdal ? "arrival_time.tif" : "arrival_time.asc")));
-  if constexpr (config::have_cairo) {  // the model's map of the run, drawn at its end (docs/fire.md, "Maps")
+  if constexpr (config::have_cairo) {  // the model's map of the run, drawn at its end (docs/reference/fire_model.md, "Maps")
     const Image map = read_png(dir / "elsewhere" / "out" / "fire_map.png");
     CHECK(map.width == 1200);
     CHECK(map.height == 900);

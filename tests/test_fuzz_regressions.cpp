@@ -1,4 +1,4 @@
-// Inputs the fuzzers of tests/fuzz found to crash, hang or leak a reader (docs/testing.md), kept in
+// Inputs the fuzzers of tests/fuzz found to crash, hang or leak a reader (docs/reference/testing.md), kept in
 // tests/fuzz/regressions/<target>-<what>: each must now end in a clean InputError, in every build
 // (the sanitizer stage of scripts/run_tests.sh replays them under ASan and UBSan too).
 #include "fuzz_inputs.hpp"

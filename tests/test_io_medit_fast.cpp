@@ -111,7 +111,7 @@ void check_same_mesh(const SurfaceMesh& a, const SurfaceMesh& b) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// GMF bytes, built here from the layout (docs/formats.md), independently of the library.
+// GMF bytes, built here from the layout (docs/reference/formats.md), independently of the library.
 
 struct Gmf {
   int version = 2;

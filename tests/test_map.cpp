@@ -1,4 +1,4 @@
-// Fire maps (map.hpp, core/map/): the layout against exact values, the isochrones of exact fields,
+// Fire maps (map.hpp, app/map/): the layout against exact values, the isochrones of exact fields,
 // and the picture Cairo draws read back and checked at known world points through the layout's
 // own world→pixel transform: the hillshade's grey, the burnt disk's edge, the isochrones' radii,
 // the scale bar's length.

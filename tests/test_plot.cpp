@@ -1,4 +1,4 @@
-// Plots (core/src/plot.cpp, `bodyfit plot`): the legend's corner, and the options the benchmark
+// Plots (app/src/plot.cpp, `bodyfit plot`): the legend's corner, and the options the benchmark
 // suite uses (scripts/bench_suite.sh: stages against faces, log-log, legend at the top left).
 #include "test_support.hpp"
 

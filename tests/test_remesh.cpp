@@ -132,7 +132,7 @@ TEST_CASE("reference polyline: a smoothed label follows the circle it samples, c
 }
 
 TEST_CASE("ReferenceSurface::smooth_normal: S's vertex normals at its vertices, continuous, converging on a sphere") {
-  // One continuous field of position (docs/fire.md, "Slope from the surface"): at a vertex of S it
+  // One continuous field of position (docs/reference/fire_model.md, "Slope from the surface"): at a vertex of S it
   // is S's vertex normal, across an edge of S it does not jump, and on a triangulated sphere it
   // converges to the exact normal, several times closer than S's face normals. (Area-weighted vertex
   // normals are first order on the geodesic sphere's irregular valences, like the face normals.)

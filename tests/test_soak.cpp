@@ -2,7 +2,7 @@
 // with a periodic speed, bench/soak_case.hpp), splitting and merging twice per period, for a few
 // hundred iterations at a coarse size. Every bound comes from an argument, not from this run's
 // figures (docs/validation/drift.md has those): the exact area where it is known, give or take
-// half an edge of front; the exact splits and merges; the issue's quality criteria; no memory
+// half an edge of front; the exact splits and merges; the quality goal; no memory
 // growth of the size of a mesh.
 #include "../bench/soak_case.hpp"
 
@@ -98,7 +98,7 @@ TEST_CASE("soak (short): two caps split and merge for 400 iterations, area, qual
     CHECK(most_components[period] >= 2);  // it split
   }
   CHECK(last_components == 1);  // and merged again
-  // The issue's criteria for the remesher's triangles.
+  // The quality goal for the remesher's triangles.
   CHECK(worst_quality > 0.2);
   CHECK(worst_share <= 0.005);
   // The sphere's faces are set by hmax; the front adds or removes a strip of refinement along it,

@@ -1,4 +1,4 @@
-// The GDAL module (see core/src/gis_module.hpp): rasters and coordinate systems through GDAL/OSR.
+// The GDAL module (see app/src/gis_module.hpp): rasters and coordinate systems through GDAL/OSR.
 #include "gis_module.hpp"
 #include "gdal_vector.hpp"
 

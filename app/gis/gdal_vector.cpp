@@ -1,4 +1,4 @@
-// Vector layers through OGR (see core/src/gis_module.hpp): ignitions in, perimeters out.
+// Vector layers through OGR (see app/src/gis_module.hpp): ignitions in, perimeters out.
 #include "gdal_vector.hpp"
 
 #include <cpl_conv.h>

@@ -1,5 +1,5 @@
 #pragma once
-// Everything bodyfit does through GDAL lives in a module loaded on first use (core/gis/,
+// Everything bodyfit does through GDAL lives in a module loaded on first use (app/gis/,
 // libbodyfit_gis.so in <libdir>/bodyfit/ beside libbodyfit_core): linked into the core, GDAL made
 // every command map its ~110 libraries at start (0.1 s of each `bodyfit distance` or `remesh`
 // call, which never reads a raster). The module is part of bodyfit, built with it from the same

@@ -1,5 +1,5 @@
 #pragma once
-// The Cairo drawing of maps lives in a module loaded on first use (core/map/, libbodyfit_map.so in
+// The Cairo drawing of maps lives in a module loaded on first use (app/map/, libbodyfit_map.so in
 // <libdir>/bodyfit/ beside libbodyfit_core), like the GDAL module (gis_module.hpp): linked into the
 // core, Cairo and its ~30 libraries would be mapped by every command. The module is built with
 // bodyfit from the same headers, so C++ types cross the boundary, under one exported symbol.

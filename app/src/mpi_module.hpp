@@ -1,5 +1,5 @@
 #pragma once
-// The MPI calls of `bodyfit ensemble` live in a module (core/mpi/, libbodyfit_mpi.so in
+// The MPI calls of `bodyfit ensemble` live in a module (app/mpi/, libbodyfit_mpi.so in
 // <libdir>/bodyfit/ beside the GDAL module), loaded only when an MPI launcher started the process
 // (or with --mpi): neither the core nor the program links MPI, so every other command, and an
 // ensemble on local threads, start without it. Built with bodyfit from the same headers.

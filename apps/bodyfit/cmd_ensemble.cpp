@@ -1,5 +1,5 @@
-// bodyfit ensemble case.toml: N members of a fire case with sampled ignitions and parameters, on
-// local threads or MPI ranks, reduced into burn-probability rasters (docs/fire.md, "Ensembles").
+// bodyfit ensemble case.toml: N members of a case with sampled regions and parameters, on
+// local threads or MPI ranks, reduced over the outputs the model declares (docs/reference/ensembles.md).
 #include "commands.hpp"
 
 #include <bodyfit/app/config.hpp>
@@ -105,9 +105,9 @@ int run_ensemble_command(const EnsembleArguments& args) {
 bodyfit::cli::Command setup_ensemble(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "ensemble",
-      "run N members of a case with sampled ignitions and parameters ([ensemble] of the case), on local "
-      "threads or MPI ranks (mpirun, srun), and reduce them into burn-probability and arrival-time rasters "
-      "(docs/fire.md, \"Ensembles\")");
+      "run N members of a case with sampled regions and parameters ([ensemble] of the case), on local "
+      "threads or MPI ranks (mpirun, srun), and reduce the outputs the model declares (probabilities, means, "
+      "percentiles) into rasters and tables (docs/reference/ensembles.md)");
   auto args = std::make_shared<EnsembleArguments>();
   // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
   cmd->add_option("case", args->case_file, "case file (.toml) with an [ensemble] table")->required();

@@ -1,4 +1,4 @@
-// bodyfit run case.toml: the whole evolution (Algorithm 1) with its outputs (docs/running.md).
+// bodyfit run case.toml: the whole evolution (Algorithm 1) with its outputs (docs/reference/running.md).
 #include "commands.hpp"
 
 #include <bodyfit/app/case_config.hpp>
@@ -196,7 +196,7 @@ int run_case(const RunArguments& args) {
 }
 
 bodyfit::cli::Command setup_run(CLI::App& app) {
-  auto* cmd = app.add_subcommand("run", "run a case: evolve the region G(t) with a velocity model (docs/running.md)");
+  auto* cmd = app.add_subcommand("run", "run a case: evolve the region G(t) with a velocity model (docs/reference/running.md)");
   auto args = std::make_shared<RunArguments>();
   // No ExistingFile check: a missing file is an input error (exit 1), as for every reader.
   cmd->add_option("case", args->case_file, "case file (.toml)")->required();

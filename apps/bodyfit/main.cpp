@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   // Keep freed blocks up to 256 MiB in the heap instead of unmapping them: every stage allocates
   // arrays of 10-130 MB at a million faces, and glibc's default maps and unmaps each one, so every
   // reuse pays a page fault per 4 KiB (a third of the CPU time was system time). Peak memory grows
-  // by about a fifth (docs/performance.md).
+  // by about a fifth (docs/validation/performance.md).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
   // The build's own documentation of the command line (self_documentation.hpp) names no path of

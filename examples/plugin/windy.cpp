@@ -6,7 +6,7 @@
 // downwind and does not grow upwind. The speed is then smoothed by H¹ regularisation over the
 // length `smoothing` (0: no smoothing), which damps the kinks of max(0, ·).
 //
-// It also shows the step lifecycle (docs/plugins.md §5): with `max_growth` > 0 it rejects a
+// It also shows the step lifecycle (docs/guide/writing_models.md §5): with `max_growth` > 0 it rejects a
 // candidate T^{n+1} whose area |G| grew by more than that fraction in one step (the driver then
 // retries with Δt/2) and keeps the smaller Δt afterwards; the number of accepted steps and the
 // areas so far are state it keeps across a resume.

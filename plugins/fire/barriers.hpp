@@ -3,7 +3,7 @@
 // layer where the fire does not spread. The rule is on the mesh, recomputed on every state from its
 // vertices (the mesh changes at every remesh): R = 0 at every vertex within barrier_reach() of a
 // barrier's lines or inside one of its polygons, so that the advection cannot carry the front
-// across (docs/fire.md, "Barriers", has the argument).
+// across (docs/reference/fire_model.md, "Barriers", has the argument).
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/velocity_model.hpp>

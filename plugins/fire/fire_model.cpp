@@ -291,14 +291,14 @@ class FireModel final : public VelocityModel {
     const VectorField& conormal = context.conormal();
     // The terrain's orientation: S's own smooth normal, the same at a point whatever mesh samples it.
     // The remeshed T^n's vertex normals average other faces at every step, and the front picked up
-    // that noise in R (docs/fire.md, "Slope from the surface").
+    // that noise in R (docs/reference/fire_model.md, "Slope from the surface").
     const VectorField& normals = surface_slope_ ? context.surface_normals() : context.vertex_normals();
     if (!wind_.has_center) {
       BoundingBox box = bounding_box(mesh);
       wind_.center = 0.5 * (box.min + box.max);
       wind_.has_center = true;
     }
-    // A wind series is a function of time: V at the time of this (sub-)step (docs/fire.md, "Wind").
+    // A wind series is a function of time: V at the time of this (sub-)step (docs/reference/fire_model.md, "Wind").
     wind_.set_clock(context.clock_start());
     const double time = context.time();
     if (context.is_height_field() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
@@ -336,7 +336,7 @@ class FireModel final : public VelocityModel {
     // V = R n + (dR/dθ) t with t the tangent of the front (n turned by +90° about the normal of S).
     // V·∇φ = R|∇φ| as for V = R n, so the front moves the same at any instant; but R n turns with
     // n along a step while this V does not, and a step traced with it no longer runs ahead of the
-    // Wulff shape on the flanks of a head (docs/fire.md, "Huygens' velocity"). dR/dθ by a central
+    // Wulff shape on the flanks of a head (docs/reference/fire_model.md, "Huygens' velocity"). dR/dθ by a central
     // difference over ±1e-3 rad: the same for any R(n), wind and fuel included.
     auto huygens_at = [&](int v, double rate) {
       const Vec3 n = front_normal(v);
@@ -446,7 +446,7 @@ class FireModel final : public VelocityModel {
     }
     if (output_dir.empty()) return;
     write_perimeters(output_dir);
-    // The run's map (docs/fire.md, "Maps"), drawn from the files just written. A map that cannot be
+    // The run's map (docs/reference/fire_model.md, "Maps"), drawn from the files just written. A map that cannot be
     // drawn (no Cairo) costs the run nothing: its results are all written.
     // Only after `bodyfit run`, which writes final.mesh first; not when a program calls evolve().
     if (!arrival_.initialised() || !config::have_cairo || !std::filesystem::exists(output_dir / "final.mesh")) return;

@@ -75,7 +75,7 @@ struct WindField {
 
 /// The declarations of [model.wind] (keys "wind.<key>").
 std::vector<ParameterDecl> wind_parameters();
-/// The [model.wind] table (docs/fire.md) read through wind_parameters(): the type and the keys it
+/// The [model.wind] table (docs/reference/fire_model.md) read through wind_parameters(): the type and the keys it
 /// uses (the others are refused when set), files relative to the case.
 WindField read_wind_table(Parameters& wind, const RasterReader& read = {});
 

@@ -24,7 +24,7 @@ LinearSolver linear_solver_from_string(std::string_view name);
 struct LinearSolverOptions {
   /// The conjugate gradient: per solve of the optimisation loop (state + adjoint), 1.4-2.2× faster
   /// than CHOLMOD's supernodal factorisation with OpenBLAS from 17k to 290k tetrahedra, 3.3× for the
-  /// first solve at 290k, on one core each (docs/thermal_solvers.md).
+  /// first solve at 290k, on one core each (docs/validation/thermal_solvers.md).
   LinearSolver solver = LinearSolver::conjugate_gradient;
   double cg_tolerance = 1e-10;  ///< conjugate gradient: relative residual |b − Ax|/|b|
   int cg_max_iterations = 0;    ///< conjugate gradient: 0 = the matrix size

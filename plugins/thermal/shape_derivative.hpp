@@ -4,7 +4,7 @@
 //   J′_ε(G)(θ) = ∫_S w (θ·n_Σ)∘π_Σ ds + ℓ ∫_Σ θ·n_Σ dℓ,    w = −(1/ε²) h′(d_G/ε) u p,
 //
 // u, p the state and adjoint of thermal_fem.hpp with κ = h_ε(d_G), d_G the signed distance to G on S
-// (negative inside), π_Σ the projection onto Σ = ∂G. Derivation (docs/thermal_solvers.md): only
+// (negative inside), π_Σ the projection onto Σ = ∂G. Derivation (docs/validation/thermal_solvers.md): only
 // h_ε depends on G in the Lagrangian, and d_G′(θ) = −(θ·n_Σ)∘π_Σ. w ≤ 0 (h′ ≤ 0, u > 0, p < 0 for
 // f ≥ 0): growing G lowers T. The paper's printed (4.17) has the opposite sign and one more 1/ε.
 //

@@ -1,6 +1,6 @@
 // The thermal shape-optimisation model (paper §4.4) as a bodyfit plugin. S = ∂Ω is the skin of a
 // part; G ⊂ S is held at temperature 0 through the Robin coefficient h_ε(d_G). The model moves G
-// along a descent direction of J_ε(G) = T_ε(G) + ℓ|G| (docs/thermal.md):
+// along a descent direction of J_ε(G) = T_ε(G) + ℓ|G| (docs/reference/thermal_model.md):
 //
 //   compute(T^n)   tetrahedralise Ω (TetGen, S kept), solve the state u and the adjoint p (one
 //                  CHOLMOD factorisation), w = −(1/ε²) h′(d/ε) u p on S, then the descent normal

@@ -29,7 +29,7 @@ struct VolumeMesh {
 
 struct TetrahedralizeOptions {
   /// TetGen -q: bound on the radius-edge ratio of the tetrahedra (≥ 1; TetGen may not terminate
-  /// much below 1.1). Measured on spheres (docs/thermal_solvers.md): 1.1-2 give the same smallest
+  /// much below 1.1). Measured on spheres (docs/validation/thermal_solvers.md): 1.1-2 give the same smallest
   /// dihedral angles (7-9°, slivers are TetGen's optimisation's business) once a volume bound is
   /// set; without one, 1.2 keeps them about 1° larger than 1.4 and 3° larger than 2.
   double radius_edge_ratio = 1.2;

@@ -40,7 +40,7 @@ std::string read_file(const std::filesystem::path& file);
 /// history.csv without its wall-clock columns (ms_*), which no two runs share.
 std::string history_without_timings(const std::filesystem::path& file);
 
-/// Path of a file in the source tree (e.g. "meshes/cube.mesh").
+/// Path of a file in the source tree (e.g. "meshes/parts/bracket_h0.07.mesh").
 std::filesystem::path source_path(const std::string& relative);
 
 }  // namespace bodyfit::test

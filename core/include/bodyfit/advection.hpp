@@ -69,7 +69,7 @@ class Advector {
   /// each vertex's characteristic back to the start of the step, where φ is `phi0`, and give φ0 at
   /// the composed foot; the foot map is interpolated every call instead of φ. φ interpolated at
   /// every sub-step's foot makes an O(h²) error each time, which adds up with the sub-steps; the
-  /// foot map is smooth, so composing feet does not (docs/validation/substeps.md).
+  /// foot map is smooth, so composing feet does not (docs/validation/advection.md, "Sub-steps that converge").
   void start_composition(const ScalarField& phi0);
   /// As advect_band, with the characteristics composed since start_composition. `phi` (the current
   /// φ, a distance near its zero set) places the feet of the vertices that no previous call traced

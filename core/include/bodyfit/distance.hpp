@@ -29,7 +29,7 @@ struct DistanceOptions {
   /// vertices beyond get the distance. The exact initialisation gives those vertices the distance to
   /// the P1 zero set, whose own P1 zero set lies O(h²κ) elsewhere: redistancing once is harmless,
   /// but the CFL sub-steps of a step redistance tens of times, and on a front that moves slowly
-  /// (the flanks of a head) the shifts add up to more than the motion (docs/validation/substeps.md).
+  /// (the flanks of a head) the shifts add up to more than the motion (docs/validation/advection.md, "Sub-steps that converge").
   /// With it, redistancing leaves the zero set exactly where it was.
   bool keep_crossings = false;
 };

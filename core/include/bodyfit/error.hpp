@@ -1,5 +1,5 @@
 #pragma once
-// Errors that reach the user, one class per exit code (docs/running.md, "Exit codes"). Every failure
+// Errors that reach the user, one class per exit code (docs/reference/running.md, "Exit codes"). Every failure
 // caused by input (a file, a parameter, a mesh that violates an assumption) is an InputError whose
 // message says where and what was expected; a velocity model that fails is a PluginError naming the
 // model, the iteration and the stage; a computation that cannot go on (a non-finite value, a bound

@@ -103,13 +103,13 @@ struct EvolutionOptions {
   /// With max_cfl: the sub-steps' redistancing keeps φ at the vertices of the faces its zero set
   /// crosses (DistanceOptions::keep_crossings), so that only the advection moves the front. false:
   /// those vertices get the distance to the P1 zero set each sub-step, which shifts the front by
-  /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/validation/substeps.md).
+  /// O(h²κ) per sub-step: the result then depends on the number of sub-steps (docs/validation/advection.md, "Sub-steps that converge").
   bool keep_crossings = true;
   /// With max_cfl: compose the sub-steps' characteristics back to the start of the step and
   /// interpolate φ^n once at the composed feet (Advector::start_composition), instead of φ at the
   /// feet of every sub-step. On a steep plane the head then lands 5 % from the exact front at 45
   /// sub-steps per step instead of 16 %; on fronts that merge it changes nothing measurable, so it
-  /// is off by default (docs/validation/substeps.md).
+  /// is off by default (docs/validation/advection.md, "Sub-steps that converge").
   bool compose_substeps = false;
   double cfl_length = 0;         ///< h of the CFL number (0: the mean edge length of the current mesh)
   /// CFL sub-steps one step may take (0: no limit): a Δt far beyond what the speeds allow is an
@@ -124,7 +124,7 @@ struct EvolutionOptions {
   /// cannot move (fixed_snap_ratio): the remesher removes the slivers, and a snap moves the interface
   /// by up to snap_ratio·h, which at 0.05 made the front noisy (RMS 4.7e-4 after one step at
   /// h = 0.05, Δt = h; 4.1e-5 without). Specks below 0.1 h² are absorbed (they come from noise in φ
-  /// and would pin poor triangles). docs/levelset_mesher.md has the measurements.
+  /// and would pin poor triangles). docs/reference/levelset_mesher.md has the measurements.
   DiscretizeOptions discretize;
   RemeshOptions remesh;          ///< set `reference` so that S never drifts
   std::filesystem::path output_dir;  ///< handed to the model (StepContext::output_dir, finish)

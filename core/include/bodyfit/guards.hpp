@@ -16,7 +16,7 @@ namespace bodyfit {
 struct RemeshOptions;
 
 /// Peak memory of the heaviest command per face of its mesh: `bodyfit run` on a sphere, measured
-/// with /usr/bin/time -v (docs/running.md, "Limits"). Used to turn a face budget into bytes.
+/// with /usr/bin/time -v (docs/reference/running.md, "Limits"). Used to turn a face budget into bytes.
 inline constexpr double kBytesPerFace = 710;
 
 /// The largest mesh (in faces) a command may build or remesh to. The default is the number of

@@ -26,7 +26,7 @@ struct ReadOptions {
 };
 
 /// Read any supported mesh format (.mesh .meshb .obj .off .ply .stl .vtu), chosen by extension.
-/// Medit refs and tags map onto the mesh properties (see docs/formats.md); e:interface is set on
+/// Medit refs and tags map onto the mesh properties (see docs/reference/formats.md); e:interface is set on
 /// edges listed with ref 10 and on edges between a face of region 3 and a face of another region.
 SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {});
 /// Write any supported mesh format (.mesh .meshb .obj .off .ply .stl .vtu), chosen by extension.

@@ -3,7 +3,7 @@
 // paper §3.4): afterwards the interface is a chain of mesh edges tagged e:interface (ref 10), the
 // faces are labelled kInside (φ < 0) or kOutside, and v:phi holds φ (0 on the interface).
 // The result is conforming but may contain thin triangles: remesh() comes next.
-// docs/levelset_mesher.md describes the cutting patterns, the snapping rule and the degenerate cases.
+// docs/reference/levelset_mesher.md describes the cutting patterns, the snapping rule and the degenerate cases.
 #include <bodyfit/mesh.hpp>
 
 #include <span>

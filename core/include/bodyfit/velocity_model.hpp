@@ -9,7 +9,7 @@
 // model declares the parameters it takes and the outputs it gives, is created once per run and
 // configured once through its declarations; the object lives for the whole run and may keep state.
 //
-// The life of one step n (docs/plugins.md has the whole picture):
+// The life of one step n (docs/guide/writing_models.md has the whole picture):
 //   compute(T^n)            V^n (once per CFL sub-step, or once per step with needs().freeze_velocity)
 //   end_step(φ^{n+1} on T^n) after each advection, before the cut (optional)
 //   review(candidate T^{n+1}) accept / reject (the driver restores T^n and retries with Δt/2; only
@@ -111,20 +111,20 @@ class StepContext {
   const std::filesystem::path& output_dir() const;  ///< where a model may write its own files
   /// Whether S is a height field z(x, y) (a landscape seen from above).
   bool is_height_field() const;
-  /// The vertices where V is needed (ABI 2.1). In the CFL sub-steps after the first, the driver
+  /// The vertices where V is needed. In the CFL sub-steps after the first, the driver
   /// works in a narrow band around Σ: it reads V only at these vertices, ignores the metrics and
   /// fields, and distance() is the distance only there (beyond, its sign is right and |d| is at
   /// least the band's width). conormal() is then filled only at these vertices. A model may
   /// compute everywhere anyway (correct, slower). Empty: every vertex (the state's own compute).
   std::span<const int> active_vertices() const;
   /// The clock time of t = 0 in seconds since 1970-01-01T00:00:00Z, when the case gives one
-  /// ([time] start; ABI 2.2): t^n is then the date-time clock_start + t^n (clock_time.hpp formats it).
+  /// ([time] start): t^n is then the date-time clock_start + t^n (clock_time.hpp formats it).
   std::optional<double> clock_start() const;
 
   const std::vector<double>& face_areas() const;
   const VectorField& face_normals() const;
   const VectorField& vertex_normals() const;
-  /// (ABI 2.5) The unit normal of the fixed input surface S at the vertices: S's vertex normals
+  /// The unit normal of the fixed input surface S at the vertices: S's vertex normals
   /// interpolated at each vertex's closest point of S (ReferenceSurface::smooth_normal). One
   /// function of position whatever T^n is, where vertex_normals() change with every remesh: what a
   /// model whose V depends on S's orientation (a slope) should read. vertex_normals() when the
@@ -168,7 +168,7 @@ struct StepOutcome {
   double time;                      ///< time at the start of this (sub-)step
   double dt;                        ///< its length
   int attempt;                      ///< 0, then 1, 2… when the step is retried after a rejection
-  /// The vertices where phi_next may differ from distance (ABI 2.1; a narrow band: φ was advected
+  /// The vertices where phi_next may differ from distance (a narrow band: φ was advected
   /// only there). Empty: anywhere.
   std::span<const int> changed = {};
 };

@@ -2,7 +2,7 @@
 // Fault injection for tests: kill the process (SIGKILL, nothing flushed, nothing cleaned up) at a
 // named write point of a run, at a given iteration — a crash at a known point instead of a race
 // with a timer — or fail the write there with an IoError (a full disk, a vanished directory).
-// `bodyfit run --inject-fault POINT:N` / `--inject-io-error POINT:N` arm it (docs/running.md lists
+// `bodyfit run --inject-fault POINT:N` / `--inject-io-error POINT:N` arm it (docs/reference/running.md lists
 // the points).
 //
 // A point is reached by the thread writing the outputs of an iteration; which iteration that is

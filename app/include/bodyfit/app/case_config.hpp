@@ -1,5 +1,5 @@
 #pragma once
-// A run case: the TOML file read by `bodyfit run` (reference: docs/running.md).
+// A run case: the TOML file read by `bodyfit run` (reference: docs/reference/case_file.md).
 //
 //   [surface]    file = "s.mesh"  |  generator = "sphere" (faces|h, radius) | "terrain" (extent, h,
 //                seed, dem, nodata, reproject, max_height, feature_size) | "plane" (size, h)
@@ -102,7 +102,7 @@ struct OutputSpec {
   std::string view = "iso";       ///< iso | top | front
   int width = 800, height = 600;
   /// The checkpoint's cadence (0 turns a criterion off); a run always checkpoints at its start,
-  /// its end and on SIGINT (docs/running.md).
+  /// its end and on SIGINT (docs/reference/running.md).
   int checkpoint_every = 0;         ///< iterations
   double checkpoint_seconds = 30;   ///< wall-clock seconds since the last checkpoint
   /// The format of the model's grid outputs: "tif" (GeoTIFF: CRS, NODATA, units; with GDAL) or

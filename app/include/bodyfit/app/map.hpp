@@ -2,7 +2,7 @@
 // Fire maps a GIS user accepts: a top view of the terrain (north up) with a hillshade, the burnt
 // area filled, isochrones of the arrival time labelled in h or min, the ignition points, a scale
 // bar in m or km, a north arrow, a legend, a title and a caption (coordinate system, date-time).
-// The drawing is Cairo's, in a module loaded on first use (core/map/, <libdir>/bodyfit/
+// The drawing is Cairo's, in a module loaded on first use (app/map/, <libdir>/bodyfit/
 // libbodyfit_map.so) so that neither the core nor the program links Cairo; the layout (where each
 // world point lands, the scale bar, the isochrone levels and lines) is computed here, in the core,
 // so that tests can check the picture against it.

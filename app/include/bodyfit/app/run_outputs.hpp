@@ -3,7 +3,7 @@
 // per state, a history row per iteration, checkpoints on the cadence (and always of the last
 // completed iteration: at the end, on an interruption, on a failure that leaves it in memory), PNG
 // snapshots, the final mesh, and the model's declared grids (model_files.hpp). The named fault
-// points (fault_injection.hpp) are those of docs/running.md.
+// points (fault_injection.hpp) are those of docs/reference/running.md.
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/model_guard.hpp>
