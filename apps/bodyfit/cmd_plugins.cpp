@@ -41,15 +41,7 @@ int list_plugins() {
 }
 
 int describe_plugin(const PluginsArguments& args) {
-  const bodyfit::LoadedModel loaded = bodyfit::load_model(args.describe);
-  bodyfit::PluginInfo info;
-  info.file = loaded.file();
-  info.abi = loaded.abi();
-  info.name = std::string(loaded->name());
-  info.version = std::string(loaded->version());
-  info.description = std::string(loaded->description());
-  info.parameters = loaded->parameters();
-  info.outputs = loaded->outputs();
+  const bodyfit::PluginInfo info = bodyfit::load_model(args.describe).info();
   fmt::print("{}", bodyfit::describe_model(info, args.markdown ? bodyfit::ReferenceFormat::Markdown
                                                                 : bodyfit::ReferenceFormat::Text));
   std::fflush(stdout);

@@ -105,6 +105,16 @@ LoadedModel& LoadedModel::operator=(LoadedModel&& other) noexcept {
 
 LoadedModel::~LoadedModel() { reset(); }
 
+PluginInfo LoadedModel::info() const {
+  return {.file = file_,
+          .abi = abi_,
+          .name = std::string(model_->name()),
+          .version = std::string(model_->version()),
+          .description = std::string(model_->description()),
+          .parameters = model_->parameters(),
+          .outputs = model_->outputs()};
+}
+
 void LoadedModel::reset() {
   // The model's code lives in the shared object: destroy it before closing the handle.
   if (model_ && destroy_) destroy_(model_);
@@ -226,16 +236,7 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
       std::string name = model_name_of(file);
       if (!seen.insert(name).second) continue;
       try {
-        LoadedModel loaded = load_plugin_file(file);
-        PluginInfo info;
-        info.file = file;
-        info.abi = loaded.abi();
-        info.name = std::string(loaded->name());
-        info.version = std::string(loaded->version());
-        info.description = std::string(loaded->description());
-        info.parameters = loaded->parameters();
-        info.outputs = loaded->outputs();
-        found.emplace(name, std::move(info));
+        found.emplace(name, load_plugin_file(file).info());
       } catch (const std::exception& e) {
         if (failures) failures->push_back(e.what());
       }

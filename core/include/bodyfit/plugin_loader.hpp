@@ -39,6 +39,8 @@ class LoadedModel {
   const std::filesystem::path& file() const { return file_; }
   /// The ABI the plugin reported (kPluginAbi of the headers it was built with).
   std::uint32_t abi() const { return abi_; }
+  /// The plugin's file, ABI and the model's self-description and declarations.
+  PluginInfo info() const;
 
  private:
   friend LoadedModel load_plugin_file(const std::filesystem::path& file);
