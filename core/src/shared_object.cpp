@@ -41,22 +41,21 @@ void* shared_object_symbol(void* handle, const char* symbol) {
 
 namespace detail {
 
-const void* load_module_table(const std::filesystem::path& file, const char* entry, std::uint32_t version, int flags,
-                              std::string_view what, std::string& failure) {
+void* module_entry(const std::filesystem::path& file, const char* entry, int flags, std::string_view what,
+                   std::string& failure) {
   void* handle = dlopen(file.c_str(), RTLD_NOW | flags);
   if (!handle) {
     const char* reason = dlerror();
     failure = fmt::format("cannot load bodyfit's {} {}: {}", what, file.string(), reason ? reason : "?");
     return nullptr;
   }
-  using Entry = const std::uint32_t* (*)();
-  auto function = reinterpret_cast<Entry>(shared_object_symbol(handle, entry));
-  const std::uint32_t* table = function ? function() : nullptr;  // the table starts with its version
-  if (!table || *table != version) {
-    failure = fmt::format("{} is not the {} of this bodyfit (reinstall bodyfit)", file.string(), what);
-    return nullptr;
-  }
-  return table;
+  void* function = shared_object_symbol(handle, entry);
+  if (!function) failure = foreign_module(file, what);
+  return function;
+}
+
+std::string foreign_module(const std::filesystem::path& file, std::string_view what) {
+  return fmt::format("{} is not the {} of this bodyfit (reinstall bodyfit)", file.string(), what);
 }
 
 }  // namespace detail

@@ -23,23 +23,32 @@ void* open_shared_object(const std::filesystem::path& file, int flags, std::stri
 void* shared_object_symbol(void* handle, const char* symbol);
 
 /// Opens a module once and fetches its table of entry points: `entry` is an extern "C" function
-/// returning `const Table*`, whose first member is a std::uint32_t version that must be `version`
-/// (a module of another bodyfit is refused). Never closed: the libraries behind modules keep
-/// process-wide state (registered drivers, font caches, a parallel runtime's initialisation).
+/// returning `const Table*`, whose member `version` must be `version` (a module of another bodyfit
+/// is refused). Never closed: the libraries behind modules keep process-wide state (registered
+/// drivers, font caches, a parallel runtime's initialisation).
 namespace detail {
-const void* load_module_table(const std::filesystem::path& file, const char* entry, std::uint32_t version, int flags,
-                              std::string_view what, std::string& failure);
-}
+/// The module's `entry` symbol, or nullptr with the reason in `failure`.
+void* module_entry(const std::filesystem::path& file, const char* entry, int flags, std::string_view what,
+                   std::string& failure);
+std::string foreign_module(const std::filesystem::path& file, std::string_view what);
+}  // namespace detail
 /// The table, or nullptr with the reason in `failure` (the same on every call: opened once).
 template <class Table>
 const Table* module_table(const std::filesystem::path& file, const char* entry, std::uint32_t version, int flags,
                           std::string_view what, std::string& failure) {
   static std::once_flag once;
-  static const void* table = nullptr;
+  static const Table* table = nullptr;
   static std::string why;
-  std::call_once(once, [&] { table = detail::load_module_table(file, entry, version, flags, what, why); });
+  std::call_once(once, [&] {
+    // Called through its own type: a call through another function type is undefined behaviour.
+    using Entry = const Table* (*)();
+    const auto function = reinterpret_cast<Entry>(detail::module_entry(file, entry, flags, what, why));
+    if (!function) return;
+    table = function();
+    if (!table || table->version != version) table = nullptr, why = detail::foreign_module(file, what);
+  });
   failure = why;
-  return static_cast<const Table*>(table);
+  return table;
 }
 
 }  // namespace bodyfit
