@@ -5,6 +5,9 @@
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/app/config.hpp>
+#include <bodyfit/app/coordinate_system.hpp>
+#include <bodyfit/app/raster_io.hpp>
+#include <bodyfit/app/map.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
@@ -15,6 +18,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -110,9 +114,40 @@ TEST_CASE("ignitions: points and lines need a radius, times need a start when th
   CHECK_THROWS_WITH_AS(setup_case(ignition_case(dir.path(), "radius = 50.0\ntime_attribute = \"ignition\"")),
                        doctest::Contains("no feature ignites at t = 0"), InputError);
   write_layer(layer, feature(R"({"type": "Point", "coordinates": [1000, 1000]})"), 32633);
-  CHECK_THROWS_WITH_AS(setup_case(ignition_case(dir.path(), "radius = 50.0")), doctest::Contains("coordinate systems"),
+  CHECK_THROWS_WITH_AS(setup_case(ignition_case(dir.path(), "radius = 50.0")),
+                       doctest::Contains("is in EPSG:32633 (WGS 84 / UTM zone 33N), the surface in EPSG:32632"),
                        InputError);
   CHECK_THROWS_AS(ignition_case(dir.path(), "radius = 50.0", "start = \"2026-07-14T13:00:00\""), InputError);  // no zone
+}
+
+TEST_CASE("ignitions: a layer in degrees follows a DEM in degrees reprojected to UTM") {
+  if constexpr (!config::have_gdal) return;
+  test::TempDir dir("ignitions_reprojected");
+  // A flat DEM in WGS 84 degrees around (6.03° E, 50.0° N), cells of 0.001°, warped to UTM 32N by
+  // the case; one ignition point in degrees at its centre.
+  HeightGrid dem;
+  dem.cols = 100, dem.rows = 60, dem.x_origin = 5.98, dem.y_origin = 49.97, dem.cell_size = 0.001;
+  dem.heights.assign(dem.cols * dem.rows, 200.0);
+  dem.crs =
+      "GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\",6378137.0,298.257223563]],"
+      "PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]]";
+  write_raster(dir / "dem.asc", dem);
+  write_layer(dir / "ignitions.geojson", feature(R"({"type": "Point", "coordinates": [6.03, 50.0]})"), 4326);
+  const std::string text = "[surface]\ngenerator = \"terrain\"\ndem = \"dem.asc\"\nreproject = \"utm\"\nh = 50.0\n"
+                           "[region]\nshape = \"ignitions\"\nfile = \"ignitions.geojson\"\nradius = 300.0\n"
+                           "[model]\nname = \"fire\"\n[time]\ndt = 50.0\nfinal_time = 100.0\n[remesh]\nhmax = 50.0\n";
+  const CaseConfig config = parse_case(toml::parse(text), dir.path());
+  const CaseSetup setup = setup_case(config);
+  // G(0): a disk of 300 m around the point, in UTM metres.
+  std::vector<PlanPoint> centre = {{6.03, 50.0}};
+  transform_points(dem.crs, case_surface_source(config).crs, centre, "centre");
+  const std::vector<PlanPolygon> outline = region_outline(setup.mesh);
+  REQUIRE(outline.size() == 1);
+  double cx = 0, cy = 0, n = 0;
+  for (const PlanPoint& p : outline[0].rings[0]) cx += p[0], cy += p[1], ++n;
+  INFO("G(0) centre (" << cx / n << ", " << cy / n << "), the point (" << centre[0][0] << ", " << centre[0][1] << ")");
+  CHECK(std::hypot(cx / n - centre[0][0], cy / n - centre[0][1]) < 10);
+  CHECK(polygon_area(outline[0]) == doctest::Approx(std::numbers::pi * 300 * 300).epsilon(0.02));
 }
 
 TEST_CASE("ignitions: a late ignition joins G at its time (the step lands on it), and the arrival raster says so") {
@@ -153,4 +188,11 @@ TEST_CASE("ignitions: a late ignition joins G at its time (the step lands on it)
   const HeightGrid arrival = read_esri_ascii(dir / "arrival_time.asc");
   CHECK(arrival.sample(500, 1000) == doctest::Approx(0));
   CHECK(arrival.sample(1500, 1000) == doctest::Approx(60));
+  // A map marks both, found where the arrival times start (a layer's ignitions are not disks of
+  // the case), within a cell of the layer's points.
+  std::vector<Vec3> points = ignitions_from_arrival(arrival);
+  REQUIRE(points.size() == 2);
+  std::sort(points.begin(), points.end(), [](const Vec3& a, const Vec3& b) { return a[0] < b[0]; });
+  CHECK(std::hypot(points[0][0] - 500, points[0][1] - 1000) < arrival.cell_size);
+  CHECK(std::hypot(points[1][0] - 1500, points[1][1] - 1000) < arrival.cell_size);
 }

@@ -16,6 +16,7 @@
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -133,6 +134,62 @@ TEST_CASE("map: isochrones of exact fields (marching squares)") {
     const double y = 0.5 * (s[0][1] + s[1][1]);  // squares of rows 1-2 (y from 50 to 90) are gone
     CHECK((y > 90 || y < 50));
   }
+}
+
+TEST_CASE("map: ignitions from the arrival time: a disk burning at t = 0 and a later point, at their centres") {
+  // Two fires on 50 m cells: a disk of 500 m around (3000, 3000) burning at t = 0, and a point
+  // at (7025, 6025) (a cell centre) lit at t = 1800 s; each spreads at 1 m/s; a cell takes the
+  // earlier front. The northern strip is NODATA (off the terrain) and holds no ignition.
+  HeightGrid grid;
+  grid.cols = grid.rows = 200;
+  grid.cell_size = 50;
+  grid.nodata = -9999;
+  grid.heights.resize(grid.cols * grid.rows);
+  for (std::size_t r = 0; r < grid.rows; ++r)
+    for (std::size_t c = 0; c < grid.cols; ++c) {
+      const double x = (double(c) + 0.5) * 50, y = (double(grid.rows - 1 - r) + 0.5) * 50;
+      const double first = std::max(0.0, std::hypot(x - 3000, y - 3000) - 500);
+      const double second = 1800 + std::hypot(x - 7025, y - 6025);
+      grid.heights[r * grid.cols + c] = y > 9000 ? grid.nodata : std::min(first, second);
+    }
+  std::vector<Vec3> points = ignitions_from_arrival(grid);
+  REQUIRE(points.size() == 2);
+  std::sort(points.begin(), points.end(), [](const Vec3& a, const Vec3& b) { return a[0] < b[0]; });
+  CHECK(points[0][0] == doctest::Approx(3000).epsilon(1e-9));  // the disk's cells are symmetric about its centre
+  CHECK(points[0][1] == doctest::Approx(3000).epsilon(1e-9));
+  CHECK(points[1][0] == doctest::Approx(7025));
+  CHECK(points[1][1] == doctest::Approx(6025));
+  // Nothing reached: no ignition.
+  std::fill(grid.heights.begin(), grid.heights.end(), grid.nodata);
+  CHECK(ignitions_from_arrival(grid).empty());
+}
+
+TEST_CASE("map: labels placed without overlap, inside the panel, the first free candidate of each line") {
+  MapLayout layout;
+  layout.panel_left = 0, layout.panel_top = 0, layout.panel_right = 100, layout.panel_bottom = 100;
+  // Line 0 takes its first box; line 1's first overlaps it, its second is free; line 2's only box
+  // leaves the panel; line 3's boxes all overlap the chosen ones.
+  const std::vector<std::vector<LabelBox>> candidates = {
+      {{10, 10, 30, 20}},
+      {{20, 15, 40, 25}, {50, 10, 70, 20}},
+      {{90, 10, 110, 20}},
+      {{15, 12, 25, 18}, {55, 12, 65, 18}},
+  };
+  const std::vector<int> chosen = place_labels(candidates, layout);
+  CHECK(chosen == std::vector<int>{0, 1, -1, -1});
+  // Boxes that only touch do not overlap.
+  CHECK(place_labels({{{0, 0, 10, 10}}, {{10, 0, 20, 10}}}, layout) == std::vector<int>{0, 0});
+}
+
+TEST_CASE("map: the caption's time from the case's start, and the map's own time") {
+  MapLayers layers;
+  CHECK(map_time_caption(layers).empty());
+  layers.clock_start = 1784034000;  // 2026-07-14T13:00:00Z
+  CHECK(map_time_caption(layers) == "fire start 2026-07-14T13:00:00Z");
+  layers.burnt_at = 5400;
+  CHECK(map_time_caption(layers) == "map at 2026-07-14T14:30:00Z, fire start 2026-07-14T13:00:00Z");
+  layers.datetime = "given";
+  CHECK(map_time_caption(layers) == "given");
 }
 
 TEST_CASE("map: the layout keeps the aspect ratio and maps the box onto the panel") {

@@ -40,8 +40,9 @@ TEST_CASE("the shipped ensemble's members sample only keys their model reads") {
   run.domain = make_placement_domain(file, {}, run.spec);
   CHECK_NOTHROW(check_member_case(run));
   CHECK(run.model == "fire");
-  REQUIRE(run.combined.size() == 1);
+  REQUIRE(run.combined.size() == 2);  // the arrival time and the rate of spread
   CHECK(run.combined[0].name == "arrival_time");
+  CHECK(run.combined[1].name == "rate_of_spread");
   // A key the model does not read with these settings (R0 comes from the fuel classes here) is refused.
   test::TempDir dir("shipped_ensemble_r0");
   // The case with its data files named absolutely, and R0 sampled.

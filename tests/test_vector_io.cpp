@@ -79,6 +79,31 @@ TEST_CASE("region_outline: parts, a hole, parts touching at a point, outer CCW, 
   CHECK(region_plan_area(mesh) == doctest::Approx(22).epsilon(1e-12));
 }
 
+TEST_CASE("cells_inside: the cells whose centre is in the outline, holes out, as the point test decides") {
+  const std::vector<PlanPolygon> polygons = region_outline(three_parts());
+  // Cells of 0.25 over [-0.5, 10.5]²: each of the 22 unit squares holds exactly 16 centres.
+  const std::size_t n = 44;
+  const double cell = 0.25, x0 = -0.5, y0 = -0.5;
+  const std::vector<bool> inside = cells_inside(polygons, n, n, x0, y0, cell);
+  REQUIRE(inside.size() == n * n);
+  std::size_t count = 0;
+  for (std::size_t row = 0; row < n; ++row)
+    for (std::size_t col = 0; col < n; ++col) {
+      const double x = x0 + (double(col) + 0.5) * cell, y = y0 + (double(n - row) - 0.5) * cell;
+      bool expected = false;
+      for (const PlanPolygon& p : polygons) expected = expected || signed_distance_to_polygon(p, x, y) < 0;
+      INFO("cell (" << row << ", " << col << ") at (" << x << ", " << y << ")");
+      CHECK(inside[row * n + col] == expected);
+      count += inside[row * n + col];
+    }
+  CHECK(count == 22 * 16);  // the planar area 22, in cells of 1/16
+  // A grid beside the polygons (nothing inside), and one within the 3 × 2 block (everything).
+  const std::vector<bool> shifted = cells_inside(polygons, 4, 4, 9.5, 6.5, 1);  // centres x 10..13, y 7..10
+  CHECK(std::count(shifted.begin(), shifted.end(), true) == 0);
+  const std::vector<bool> corner = cells_inside(polygons, 2, 2, 7, 6, 1);  // centres (7.5|8.5, 6.5|7.5)
+  CHECK(std::count(corner.begin(), corner.end(), true) == 4);
+}
+
 TEST_CASE("write_polygon_layer: a GeoPackage and a GeoJSON read back by OGR with CRS, valid geometries and areas") {
   if constexpr (!config::have_gdal) return;
   const SurfaceMesh mesh = three_parts();

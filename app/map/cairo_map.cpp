@@ -163,17 +163,27 @@ void draw_isochrones(cairo_t* cr, const MapLayers& layers, const std::vector<dou
     cairo_set_line_width(cr, 2.5);
     cairo_stroke(cr);
   }
-  // Each line labelled once, at its northernmost point (a column of labels a reader scans down).
+  // Each line labelled once, as far north as it can be without covering another line's label
+  // (a column of labels a reader scans down): candidates from its northernmost segment southwards.
   select_font(cr, fonts.small, true);
+  std::vector<std::string> labels(levels.size());
+  std::vector<std::vector<LabelBox>> candidates(levels.size());
   for (std::size_t i = 0; i < levels.size(); ++i) {
-    if (lines[i].empty()) continue;
-    const auto top = std::max_element(lines[i].begin(), lines[i].end(), [](const auto& a, const auto& b) {
-      return a[0][1] + a[1][1] < b[0][1] + b[1][1];
-    });
-    const Vec3 mid = 0.5 * ((*top)[0] + (*top)[1]);
-    const MapPixel p = layout.to_pixel(mid[0], mid[1]);
-    const std::string label = time_label(levels[i], interval, options);
-    draw_text(cr, p.x - text_width(cr, label) / 2, p.y - 5, label, true);
+    labels[i] = time_label(levels[i], interval, options);
+    const double w = text_width(cr, labels[i]), h = fonts.small;
+    std::vector<MapPixel> mids;
+    for (const auto& s : lines[i]) mids.push_back(layout.to_pixel(0.5 * (s[0][0] + s[1][0]), 0.5 * (s[0][1] + s[1][1])));
+    std::sort(mids.begin(), mids.end(), [](const MapPixel& a, const MapPixel& b) { return a.y < b.y; });
+    // At most 64 tries a line: a label needs room, not every position.
+    const std::size_t step = std::max<std::size_t>(1, mids.size() / 64);
+    for (std::size_t k = 0; k < mids.size(); k += step)
+      candidates[i].push_back({mids[k].x - w / 2 - 2, mids[k].y - 5 - h, mids[k].x + w / 2 + 2, mids[k].y - 1});
+  }
+  const std::vector<int> chosen = place_labels(candidates, layout);
+  for (std::size_t i = 0; i < levels.size(); ++i) {
+    if (chosen[i] < 0) continue;
+    const LabelBox& box = candidates[i][std::size_t(chosen[i])];
+    draw_text(cr, box.x0 + 2, box.y1 - 4, labels[i], true);
   }
 }
 
@@ -370,7 +380,7 @@ void draw_title_and_caption(cairo_t* cr, const MapLayers& layers, const MapLayou
   std::vector<std::string> parts;
   parts.push_back(layers.crs_name.empty() ? std::string("x, y in metres (no coordinate system given)")
                                           : fmt::format("Coordinate system: {}", layers.crs_name));
-  if (!layers.datetime.empty()) parts.push_back(layers.datetime);
+  if (const std::string when = map_time_caption(layers); !when.empty()) parts.push_back(when);
   parts.push_back("north up");
   parts.push_back(fmt::format("drawn by bodyfit {}", config::version));
   std::string caption;

@@ -60,11 +60,11 @@ double ignition_time(const CaseConfig& config, const AttributeValue& value, std:
 /// surface is one), a radius for points and lines, ignition times.
 std::vector<Ignition> read_ignitions(const CaseConfig& config) {
   const auto& r = config.region;
-  const VectorLayer layer = read_vector_layer(r.ignitions);
-  // The surface's system (after its reprojection, when the case asks for one), not the DEM file's.
-  if (!layer.crs.empty() && !config.surface.dem.empty()) {
+  VectorLayer layer = read_vector_layer(r.ignitions);
+  // In the surface's system (after its reprojection, when the case asks for one), as every layer.
+  if (!config.surface.dem.empty()) {
     const SurfaceSource surface = case_surface_source(config);
-    require_crs(layer.crs, r.ignitions, surface.crs, surface.file);
+    to_surface_crs(layer, r.ignitions, surface.crs, surface.reprojected_from, surface.file);
   }
   std::vector<Ignition> ignitions;
   for (std::size_t i = 0; i < layer.features.size(); ++i) {

@@ -74,33 +74,6 @@ bool same_frame(const HeightGrid& a, const HeightGrid& b) {
          a.cell_size == b.cell_size;
 }
 
-/// The speed of a front 1/|∇t| in plan view from its times of arrival (central differences,
-/// one-sided at the edge of the reached cells); NaN where a direction has no reached neighbour or
-/// ∇t = 0 (G(0), reached at t = 0 all at once).
-std::vector<double> front_speed(const HeightGrid& t) {
-  std::vector<double> speed(t.heights.size(), kNaN);
-  auto value = [&](long r, long c) {
-    if (r < 0 || c < 0 || r >= long(t.rows) || c >= long(t.cols)) return kNaN;
-    return t.at(std::size_t(r), std::size_t(c));
-  };
-  auto derivative = [&](double minus, double centre, double plus) {
-    if (!std::isnan(minus) && !std::isnan(plus)) return (plus - minus) / (2 * t.cell_size);
-    if (!std::isnan(plus)) return (plus - centre) / t.cell_size;
-    if (!std::isnan(minus)) return (centre - minus) / t.cell_size;
-    return kNaN;
-  };
-  for (long r = 0; r < long(t.rows); ++r)
-    for (long c = 0; c < long(t.cols); ++c) {
-      const double centre = value(r, c);
-      if (std::isnan(centre)) continue;
-      const double dx = derivative(value(r, c - 1), centre, value(r, c + 1));
-      const double dy = derivative(value(r + 1, c), centre, value(r - 1, c));  // rows run north to south
-      const double g = std::hypot(dx, dy);
-      if (std::isfinite(g) && g > 0) speed[std::size_t(r) * t.cols + std::size_t(c)] = 1 / g;
-    }
-  return speed;
-}
-
 /// Linear interpolation between closest ranks (the "type 7" percentile of sorted values).
 double percentile(const std::vector<double>& sorted, double p) {
   const double position = p / 100 * double(sorted.size() - 1);
@@ -159,7 +132,8 @@ void write_share_picture(const fs::path& file, const HeightGrid& share, const st
   for (std::size_t r = 0; r < share.rows; ++r)
     for (std::size_t c = 0; c < share.cols; ++c) {
       const double p = share.at(r, c);
-      const Rgb colour = p > 0 ? colormap(p / highest) : Rgb{225, 225, 225};
+      // White off the surface, grey where no member reached.
+      const Rgb colour = p == share.nodata ? Rgb{255, 255, 255} : p > 0 ? colormap(p / highest) : Rgb{225, 225, 225};
       image.fill_rect(int(c) * scale, top + int(r) * scale, int(c + 1) * scale, top + int(r + 1) * scale, colour);
     }
   const int x0 = width + 20;
@@ -190,8 +164,7 @@ void reduce_output(const EnsembleRun& run, const OutputDecl& output, const std::
   HeightGrid frame;
   fs::path frame_file;
   std::vector<std::uint32_t> reached;
-  std::vector<double> sum, speed_sum;
-  std::vector<std::uint32_t> speed_count;
+  std::vector<double> sum;
   std::vector<std::vector<double>> values;  // per cell, the members' values
   for (const MemberRecord& record : records) {
     if (!record.ok) continue;
@@ -204,7 +177,7 @@ void reduce_output(const EnsembleRun& run, const OutputDecl& output, const std::
       prj.replace_extension(".prj");
       if (fs::exists(prj)) frame.crs = read_text(prj);
       const std::size_t cells = grid.heights.size();
-      reached.assign(cells, 0), sum.assign(cells, 0), speed_sum.assign(cells, 0), speed_count.assign(cells, 0);
+      reached.assign(cells, 0), sum.assign(cells, 0);
       values.assign(cells, {});
     } else if (!same_frame(frame, grid)) {
       throw InputError(fmt::format("{} and {}: the members' '{}' grids differ ({} × {} cells of {} at ({}, {}) against "
@@ -214,23 +187,26 @@ void reduce_output(const EnsembleRun& run, const OutputDecl& output, const std::
                                    frame.cell_size, frame.x_origin, frame.y_origin, grid.cols, grid.rows,
                                    grid.cell_size, grid.x_origin, grid.y_origin));
     }
-    const bool wants_speed = std::any_of(output.ensemble.begin(), output.ensemble.end(),
-                                         [](const Combine& c) { return c.op == Combine::Op::FrontSpeed; });
-    const std::vector<double> speed = wants_speed ? front_speed(grid) : std::vector<double>();
     for (std::size_t c = 0; c < grid.heights.size(); ++c) {
       const double t = grid.heights[c];
       if (std::isnan(t)) continue;
       ++reached[c];
       sum[c] += t;
       values[c].push_back(t);
-      if (wants_speed && !std::isnan(speed[c])) speed_sum[c] += speed[c], ++speed_count[c];
     }
+  }
+  // Off the surface nothing is combined: a cell belongs to the grid's domain when its centre lies
+  // on the surface seen from above, or when a member gave it a value.
+  std::vector<bool> domain(frame.heights.size(), true);
+  if (!run.domain.footprint.empty()) {
+    domain = cells_inside(run.domain.footprint, frame.cols, frame.rows, frame.x_origin, frame.y_origin, frame.cell_size);
+    for (std::size_t c = 0; c < domain.size(); ++c) domain[c] = domain[c] || reached[c] > 0;
   }
   auto raster = [&](auto&& value_of) {
     HeightGrid out = frame;
     out.nodata = kGridNodata;
     for (std::size_t c = 0; c < out.heights.size(); ++c) {
-      const double v = value_of(c);
+      const double v = domain[c] ? value_of(c) : kNaN;
       out.heights[c] = std::isnan(v) ? out.nodata : v;
     }
     return out;
@@ -260,12 +236,6 @@ void reduce_output(const EnsembleRun& run, const OutputDecl& output, const std::
                                 }),
                                 {.units = how.unit, .description = describe(how.description, members, p)});
         }
-        break;
-      case Combine::Op::FrontSpeed:
-        write_ensemble_raster(file, raster([&](std::size_t c) {
-                                return speed_count[c] ? speed_sum[c] / double(speed_count[c]) : kNaN;
-                              }),
-                              {.units = how.unit, .description = describe(how.description, members)});
         break;
     }
   }

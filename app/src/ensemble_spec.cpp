@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace bodyfit {
@@ -75,14 +76,10 @@ std::string toml_number(double v) {
   return text;
 }
 
-bool inside_polygon(const std::vector<std::array<double, 2>>& polygon, double x, double y) {
-  bool inside = false;
-  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-    const auto& a = polygon[i];
-    const auto& b = polygon[j];
-    if ((a[1] > y) != (b[1] > y) && x < (b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]) inside = !inside;
-  }
-  return inside;
+bool on_footprint(const std::vector<PlanPolygon>& footprint, double x, double y) {
+  if (footprint.empty()) return true;
+  return std::any_of(footprint.begin(), footprint.end(),
+                     [&](const PlanPolygon& p) { return signed_distance_to_polygon(p, x, y) < 0; });
 }
 
 bool mask_allows(const HeightGrid& mask, double x, double y) {
@@ -145,13 +142,15 @@ PlacementDomain make_placement_domain(const std::filesystem::path& case_file, co
   PlacementDomain domain;
   domain.polygon = spec.region.polygon;
   domain.radius = spec.region.radius;
-  if (domain.polygon.empty() || domain.radius == 0) {
-    const CaseConfig config = read_case(case_file, overrides);
-    const SurfaceMesh surface = make_case_surface(config);
-    const BoundingBox box = bounding_box(surface);
-    if (domain.polygon.empty())
-      domain.polygon = {{box.min[0], box.min[1]}, {box.max[0], box.min[1]}, {box.max[0], box.max[1]}, {box.min[0], box.max[1]}};
-    if (domain.radius == 0) domain.radius = 2 * edge_length_stats(surface).mean;
+  const CaseConfig config = read_case(case_file, overrides);
+  SurfaceMesh surface = make_case_surface(config);
+  const BoundingBox box = bounding_box(surface);
+  if (domain.polygon.empty())
+    domain.polygon = {{box.min[0], box.min[1]}, {box.max[0], box.min[1]}, {box.max[0], box.max[1]}, {box.min[0], box.max[1]}};
+  if (domain.radius == 0) domain.radius = 2 * edge_length_stats(surface).mean;
+  if (config.surface.kind == SurfaceSpec::Kind::Terrain) {
+    for (auto f : surface.faces()) surface.region(f) = kInside;
+    domain.footprint = region_outline(surface);
   }
   domain.xmin = domain.xmax = domain.polygon[0][0];
   domain.ymin = domain.ymax = domain.polygon[0][1];
@@ -171,7 +170,7 @@ MemberScenario sample_member(const EnsembleSpec& spec, const PlacementDomain& do
                                        (domain.xmax - domain.xmin);
     const double y = domain.ymin + uniform01(spec.seed, index, kPlacementStream, 2 * std::uint64_t(attempt) + 1) *
                                        (domain.ymax - domain.ymin);
-    if (inside_polygon(domain.polygon, x, y) && mask_allows(domain.mask, x, y)) {
+    if (inside_ring(domain.polygon, x, y) && mask_allows(domain.mask, x, y) && on_footprint(domain.footprint, x, y)) {
       s.x = x, s.y = y;
       s.placed = true;
       break;

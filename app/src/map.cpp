@@ -5,6 +5,7 @@
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/app/case_config.hpp>
+#include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/app/raster_io.hpp>
@@ -141,6 +142,84 @@ Rgb isochrone_colour(std::size_t index, std::size_t count) {
   return colormap(count < 2 ? 0.5 : double(index) / double(count - 1));
 }
 
+std::vector<Vec3> ignitions_from_arrival(const HeightGrid& grid) {
+  const std::size_t rows = grid.rows, cols = grid.cols;
+  auto value = [&](long r, long c) {
+    if (r < 0 || c < 0 || r >= long(rows) || c >= long(cols)) return std::numeric_limits<double>::quiet_NaN();
+    const double t = grid.at(std::size_t(r), std::size_t(c));
+    return reached(t, grid.nodata) ? t : std::numeric_limits<double>::quiet_NaN();
+  };
+  // A cell is on an ignition plateau when no reached neighbour (8 of them) was reached earlier.
+  std::vector<char> lowest(rows * cols, 0);
+  for (long r = 0; r < long(rows); ++r)
+    for (long c = 0; c < long(cols); ++c) {
+      const double t = value(r, c);
+      if (std::isnan(t)) continue;
+      bool low = true;
+      for (long dr = -1; dr <= 1 && low; ++dr)
+        for (long dc = -1; dc <= 1 && low; ++dc) low = !(value(r + dr, c + dc) < t);
+      lowest[std::size_t(r) * cols + std::size_t(c)] = low;
+    }
+  // Plateaus: connected cells (8 neighbours) of one arrival time.
+  std::vector<Vec3> points;
+  std::vector<char> seen(rows * cols, 0);
+  std::vector<std::size_t> stack;
+  for (std::size_t start = 0; start < rows * cols; ++start) {
+    if (!lowest[start] || seen[start]) continue;
+    const double t = grid.heights[start];
+    double sx = 0, sy = 0;
+    std::size_t n = 0;
+    stack.assign(1, start);
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const std::size_t cell = stack.back();
+      stack.pop_back();
+      const long r = long(cell / cols), c = long(cell % cols);
+      sx += grid.x_origin + (double(c) + 0.5) * grid.cell_size;
+      sy += grid.y_origin + (double(rows) - double(r) - 0.5) * grid.cell_size;
+      ++n;
+      for (long dr = -1; dr <= 1; ++dr)
+        for (long dc = -1; dc <= 1; ++dc) {
+          const long rr = r + dr, cc = c + dc;
+          if (rr < 0 || cc < 0 || rr >= long(rows) || cc >= long(cols)) continue;
+          const std::size_t next = std::size_t(rr) * cols + std::size_t(cc);
+          if (lowest[next] && !seen[next] && grid.heights[next] == t) seen[next] = 1, stack.push_back(next);
+        }
+    }
+    points.emplace_back(sx / double(n), sy / double(n), 0.0);
+  }
+  return points;
+}
+
+std::string map_time_caption(const MapLayers& layers) {
+  if (!layers.datetime.empty()) return layers.datetime;
+  if (!layers.clock_start) return {};
+  std::string text = "fire start " + format_iso8601(*layers.clock_start);
+  if (layers.burnt_at) text = "map at " + format_iso8601(*layers.clock_start + *layers.burnt_at) + ", " + text;
+  return text;
+}
+
+std::vector<int> place_labels(const std::vector<std::vector<LabelBox>>& candidates, const MapLayout& layout) {
+  std::vector<int> chosen(candidates.size(), -1);
+  std::vector<LabelBox> placed;
+  auto overlaps = [](const LabelBox& a, const LabelBox& b) {
+    return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
+  };
+  for (std::size_t line = 0; line < candidates.size(); ++line)
+    for (std::size_t k = 0; k < candidates[line].size(); ++k) {
+      const LabelBox& box = candidates[line][k];
+      if (box.x0 < layout.panel_left || box.x1 > layout.panel_right || box.y0 < layout.panel_top ||
+          box.y1 > layout.panel_bottom)
+        continue;
+      if (std::any_of(placed.begin(), placed.end(), [&](const LabelBox& other) { return overlaps(box, other); }))
+        continue;
+      chosen[line] = int(k);
+      placed.push_back(box);
+      break;
+    }
+  return chosen;
+}
+
 std::vector<std::array<Vec3, 2>> isochrone_segments(const HeightGrid& grid, double level) {
   std::vector<std::array<Vec3, 2>> segments;
   if (grid.cols < 2 || grid.rows < 2) return segments;
@@ -227,11 +306,19 @@ RunMap load_run_map(const std::filesystem::path& run_dir) {
     }
   if (const fs::path case_file = run_dir / "case.toml"; fs::exists(case_file)) {
     const toml::table table = read_case_table(case_file);
-    if (table["region"]["shape"].value_or(std::string()) == "disks")
+    if (table["region"]["shape"].value_or(std::string()) == "disks") {
       if (const toml::array* centres = table["region"]["centers"].as_array())
         for (const toml::node& centre : *centres)
           if (const toml::array* xy = centre.as_array(); xy && xy->size() >= 2)
             run.layers.ignitions.emplace_back((*xy)[0].value_or(0.0), (*xy)[1].value_or(0.0), 0.0);
+    } else if (run.layers.arrival.cols > 0) {
+      // Ignitions from a layer (points, lines, polygons, some later than others), or any shape:
+      // where the arrival time starts.
+      run.layers.ignitions = ignitions_from_arrival(run.layers.arrival);
+    }
+    if (const auto start = table["time"]["start"].value<std::string>()) {
+      run.layers.clock_start = parse_iso8601(*start);
+    }
   }
   return run;
 }

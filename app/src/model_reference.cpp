@@ -27,7 +27,6 @@ std::string combine_words(const Combine& c) {
     case Combine::Op::Share: return fmt::format("{}: share of members", c.name);
     case Combine::Op::Mean: return fmt::format("{}: mean", c.name);
     case Combine::Op::Percentiles: return fmt::format("{}<p>: percentiles", c.name);
-    case Combine::Op::FrontSpeed: return fmt::format("{}: mean of 1/|∇t|", c.name);
   }
   return c.name;
 }

@@ -66,6 +66,32 @@ bool inside_ring(const PlanPath& ring, double x, double y) {
   return inside;
 }
 
+std::vector<bool> cells_inside(const std::vector<PlanPolygon>& polygons, std::size_t cols, std::size_t rows,
+                               double x_origin, double y_origin, double cell_size) {
+  std::vector<bool> inside(cols * rows, false);
+  std::vector<double> crossings;
+  for (std::size_t row = 0; row < rows; ++row) {
+    const double y = y_origin + (double(rows - row) - 0.5) * cell_size;
+    crossings.clear();
+    for (const PlanPolygon& polygon : polygons)
+      for (const PlanPath& ring : polygon.rings)
+        for (std::size_t i = 0, n = ring.size(), j = n - 1; i < n; j = i++) {
+          const PlanPoint& a = ring[i];
+          const PlanPoint& b = ring[j];
+          if ((a[1] > y) != (b[1] > y)) crossings.push_back((b[0] - a[0]) * (y - a[1]) / (b[1] - a[1]) + a[0]);
+        }
+    std::sort(crossings.begin(), crossings.end());
+    // Between the 2k-th and (2k+1)-th crossings: inside, as inside_ring decides a point.
+    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+      const double first = std::floor((crossings[k] - x_origin) / cell_size - 0.5) + 1;
+      const double last = std::ceil((crossings[k + 1] - x_origin) / cell_size - 0.5) - 1;
+      for (double c = std::max(first, 0.0); c <= std::min(last, double(cols) - 1); ++c)
+        inside[row * cols + std::size_t(c)] = true;
+    }
+  }
+  return inside;
+}
+
 double distance_to_path(const PlanPath& path, double x, double y, bool closed) {
   if (path.empty()) return std::numeric_limits<double>::infinity();
   if (path.size() == 1) return std::hypot(x - path[0][0], y - path[0][1]);

@@ -1,10 +1,12 @@
 #include <bodyfit/app/vector_io.hpp>
+#include <bodyfit/app/coordinate_system.hpp>
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
 
 #include "gis_module.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cctype>
@@ -16,6 +18,45 @@ const AttributeValue& VectorFeature::attribute(const std::string& name) const {
   for (const auto& [key, value] : attributes)
     if (key == name) return value;
   return null;
+}
+
+void to_surface_crs(VectorLayer& layer, const std::filesystem::path& file, const std::string& surface_crs,
+                    const std::string& reprojected_from, const std::filesystem::path& surface_file) {
+  if (layer.crs.empty()) {
+    if (!surface_crs.empty())
+      spdlog::warn("{}: no coordinate system: its coordinates are taken as the surface's ({})", file.string(),
+                   crs_label(surface_crs, surface_file));
+    return;
+  }
+  if (surface_crs.empty() || same_crs(layer.crs, surface_crs, file)) return;
+  if (reprojected_from.empty() || !geographic_crs(layer.crs, file)) {
+    const std::string surface = reprojected_from.empty()
+                                    ? crs_label(surface_crs, surface_file)
+                                    : fmt::format("{}, the system {} was reprojected to", crs_label(surface_crs, surface_file),
+                                                  surface_file.string());
+    throw InputError(fmt::format("{} is in {}, the surface in {}: one case has one system; reproject the layer "
+                                 "(ogr2ogr -t_srs), or give it in degrees when the case reprojects its DEM",
+                                 file.string(), crs_label(layer.crs, file), surface));
+  }
+  // The case warped its DEM from degrees to UTM: a layer in degrees follows it.
+  std::vector<PlanPoint*> where;
+  for (auto& feature : layer.features) {
+    auto& g = feature.geometry;
+    for (auto& p : g.points) where.push_back(&p);
+    for (auto& line : g.lines)
+      for (auto& p : line) where.push_back(&p);
+    for (auto& polygon : g.polygons)
+      for (auto& ring : polygon.rings)
+        for (auto& p : ring) where.push_back(&p);
+  }
+  std::vector<PlanPoint> points;
+  points.reserve(where.size());
+  for (const PlanPoint* p : where) points.push_back(*p);
+  transform_points(layer.crs, surface_crs, points, file);
+  for (std::size_t i = 0; i < points.size(); ++i) *where[i] = points[i];
+  spdlog::info("{}: reprojected from {} to {}, the surface's", file.string(), crs_label(layer.crs, file),
+               crs_label(surface_crs, surface_file));
+  layer.crs = surface_crs;
 }
 
 VectorLayer read_vector_layer(const std::filesystem::path& file, const std::string& name) {

@@ -61,7 +61,7 @@ int map_command(const MapArguments& args) {
     run.layers.crs_name = crs_name_of_wkt(run.layers.arrival.crs);
   }
   if (!args.crs.empty()) run.layers.crs_name = args.crs;
-  run.layers.datetime = args.datetime;
+  if (!args.datetime.empty()) run.layers.datetime = args.datetime;
   if (args.at || args.every) {
     if (run.layers.arrival.cols == 0)
       throw InputError(fmt::format("{}: --at and --every draw the burnt area from the arrival times, and there are none "
@@ -117,7 +117,7 @@ bodyfit::cli::Command setup_map(CLI::App& app) {
   cmd->add_option("--every", args->every,
                   "one map per multiple of this time (s) up to the last arrival, named map_001800s.png after -o map.png")
       ->check(bodyfit::cli::finite_above(0));
-  cmd->add_option("--datetime", args->datetime, "date and time for the caption, e.g. \"2026-07-14 16:00 UTC\"");
+  cmd->add_option("--datetime", args->datetime, "date and time for the caption, e.g. \"2026-07-14 16:00 UTC\" (default: from the run's [time] start, the fire's start and the map's time)");
   return {cmd, [args]() { return map_command(*args); }};
 }
 

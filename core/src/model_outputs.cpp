@@ -34,9 +34,6 @@ Combine Combine::mean(std::string name, std::string unit, std::string descriptio
 Combine Combine::percentiles(std::string name, std::string unit, std::string description) {
   return make_combine(Op::Percentiles, std::move(name), std::move(unit), std::move(description));
 }
-Combine Combine::front_speed(std::string name, std::string unit, std::string description) {
-  return make_combine(Op::FrontSpeed, std::move(name), std::move(unit), std::move(description));
-}
 
 OutputDecl OutputDecl::vertex_field(std::string name, std::string unit, std::string description) {
   return make_output(Kind::VertexField, std::move(name), std::move(unit), std::move(description));

@@ -1,6 +1,5 @@
 #include "barriers.hpp"
 
-#include <bodyfit/app/coordinate_system.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/app/vector_io.hpp>
 
@@ -12,45 +11,10 @@
 #include <limits>
 
 namespace bodyfit::fire {
-namespace {
-
-/// Every point of every geometry of the layer, in place (for a transformation in one call).
-std::vector<PlanPoint*> points_of(VectorLayer& layer) {
-  std::vector<PlanPoint*> points;
-  for (auto& feature : layer.features) {
-    auto& g = feature.geometry;
-    for (auto& p : g.points) points.push_back(&p);
-    for (auto& line : g.lines)
-      for (auto& p : line) points.push_back(&p);
-    for (auto& polygon : g.polygons)
-      for (auto& ring : polygon.rings)
-        for (auto& p : ring) points.push_back(&p);
-  }
-  return points;
-}
-
-}  // namespace
 
 Barriers Barriers::read(const BarrierOptions& options, const SurfaceSource& surface) {
   VectorLayer layer = read_vector_layer(options.file, options.layer);
-  if (layer.crs.empty()) {
-    if (!surface.crs.empty())
-      spdlog::warn("{}: no coordinate system: its coordinates are taken as the surface's ({})", options.file.string(),
-                   crs_label(surface.crs, surface.file));
-  } else if (!surface.reprojected_from.empty() && !same_crs(layer.crs, surface.crs, options.file) &&
-             geographic_crs(layer.crs, options.file)) {
-    // The case warped its DEM from degrees to UTM: a layer in degrees follows it.
-    std::vector<PlanPoint*> where = points_of(layer);
-    std::vector<PlanPoint> points;
-    points.reserve(where.size());
-    for (const PlanPoint* p : where) points.push_back(*p);
-    transform_points(layer.crs, surface.crs, points, options.file);
-    for (std::size_t i = 0; i < points.size(); ++i) *where[i] = points[i];
-    spdlog::info("{}: barriers reprojected from {} to {}, the surface's", options.file.string(),
-                 crs_label(layer.crs, options.file), crs_label(surface.crs, surface.file));
-  } else {
-    require_crs(layer.crs, options.file, surface.crs, surface.file);
-  }
+  to_surface_crs(layer, options.file, surface.crs, surface.reprojected_from, surface.file);
   Barriers barriers;
   barriers.width_ = options.width;
   for (const auto& feature : layer.features) barriers.add_geometry(feature.geometry);

@@ -183,10 +183,10 @@ class FireModel final : public VelocityModel {
             .combine(Combine::share("burn_probability", "burn probability over {members} members"))
             .combine(Combine::mean("arrival_mean", "s", "mean arrival time over the members that reached the cell"))
             .combine(Combine::percentiles("arrival_p", "s", "arrival time, percentile {percentile} over the members "
-                                                            "that reached the cell"))
-            .combine(Combine::front_speed("ros_mean", "m/s", "conditional rate of spread (1/|grad t|), mean over the "
-                                                             "members")),
-        OutputDecl::grid("rate_of_spread", "m/s", "the rate of spread at which each cell burnt (terrains)"),
+                                                            "that reached the cell")),
+        OutputDecl::grid("rate_of_spread", "m/s", "the rate of spread at which each cell burnt (terrains)")
+            .combine(Combine::mean("ros_mean", "m/s", "rate of spread at which the cell burnt, mean over the members "
+                                                      "that burnt it (cells burning at the start have none)")),
         OutputDecl::value("burnt_area", "m²", "|G| at the end: the area burnt, on the surface"),
         OutputDecl::file("perimeters.gpkg", "the burnt region's outline (perimeters.file)"),
         OutputDecl::file("perimeters.geojson", "the same as GeoJSON (perimeters.file)"),

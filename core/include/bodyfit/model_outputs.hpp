@@ -44,7 +44,6 @@ struct Combine {
     Share,        ///< the share of members with a value in a cell (a probability), 0 to 1
     Mean,         ///< the mean over the members with a value
     Percentiles,  ///< each of the ensemble's percentiles over the members with a value: <name><p>
-    FrontSpeed,   ///< for the time t at which a front reached each cell: the mean of 1/|∇t|
   };
   Op op = Op::Mean;
   std::string name;
@@ -54,7 +53,6 @@ struct Combine {
   static Combine share(std::string name, std::string description);
   static Combine mean(std::string name, std::string unit, std::string description);
   static Combine percentiles(std::string name, std::string unit, std::string description);
-  static Combine front_speed(std::string name, std::string unit, std::string description);
 };
 
 /// One output of a model.

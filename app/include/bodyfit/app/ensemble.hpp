@@ -24,6 +24,7 @@
 // the reduction reads them in index order, so its outputs are bit-identical for any number of
 // ranks or threads and any scheduling.
 #include <bodyfit/app/dem.hpp>
+#include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/app/process_group.hpp>
 #include <bodyfit/app/raster_io.hpp>
 #include <bodyfit/model_outputs.hpp>
@@ -71,14 +72,18 @@ struct EnsembleSpec {
 /// Read [ensemble] of a case file after the overrides (`--set`); InputError naming file and line.
 EnsembleSpec read_ensemble_spec(const std::filesystem::path& case_file, const std::vector<std::string>& overrides);
 
-/// Where the points may be drawn: the polygon or the surface's plan-view box, and the mask.
+/// Where the points may be drawn: the polygon or the surface's plan-view box, on the surface, and
+/// the mask.
 struct PlacementDomain {
   std::vector<std::array<double, 2>> polygon;  ///< closed implicitly; ≥ 3 points
   double xmin = 0, xmax = 0, ymin = 0, ymax = 0;
   HeightGrid mask;  ///< cols == 0: no mask
   double radius = 0;
+  /// A height field seen from above (its outline, holes included); empty for other surfaces. A
+  /// centre must lie on it, and the combined grids have no value off it.
+  std::vector<PlanPolygon> footprint;
 };
-/// The domain of a case (builds S once when it needs its box or its mean edge).
+/// The domain of a case (builds S once: its footprint, its box, its mean edge).
 PlacementDomain make_placement_domain(const std::filesystem::path& case_file, const std::vector<std::string>& overrides,
                                       const EnsembleSpec& spec);
 

@@ -27,6 +27,9 @@ struct MapLayers {
   std::vector<Vec3> ignitions;  ///< points (x, y) marked with a star
   std::string crs_name;         ///< e.g. "WGS 84 / UTM zone 32N", shown in the caption
   std::string datetime;         ///< e.g. "2026-07-14 16:00 UTC", shown in the caption
+  /// The clock time of t = 0 (seconds since 1970, the case's [time] start): the caption then says
+  /// when the fire started and, with `burnt_at`, the date-time of the map (map_time_caption).
+  std::optional<double> clock_start;
   /// The burnt area at this time (s after t = 0; `bodyfit map --at`): the cells of `arrival`
   /// reached at or before it are filled and outlined instead of G's faces, and only the isochrones
   /// up to it are drawn. None: G of the mesh (the final state).
@@ -101,6 +104,24 @@ Rgb isochrone_colour(std::size_t index, std::size_t count);
 /// NaN or NODATA cells break the line), as world segments.
 std::vector<std::array<Vec3, 2>> isochrone_segments(const HeightGrid& arrival, double level);
 
+/// Where fires started, from their arrival times: a front only moves away from its ignitions, so
+/// each ignition is a plateau of cells no later than any neighbour (a disk burning at t = 0, a later
+/// ignition at its time). The centroid of each such plateau of connected cells, in world (x, y).
+std::vector<Vec3> ignitions_from_arrival(const HeightGrid& arrival);
+
+/// The caption's time: `datetime` when given; else, with a clock start, "fire start <date-time>"
+/// and, for a map at a time, "map at <date-time>"; else "".
+std::string map_time_caption(const MapLayers& layers);
+
+/// A label's box on the picture, in pixels.
+struct LabelBox {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+/// For each line, the index of the first of its candidate boxes (in order of preference) that
+/// lies within the map panel and overlaps no box chosen before it; -1 when none does (the line
+/// goes unlabelled: the legend gives its time).
+std::vector<int> place_labels(const std::vector<std::vector<LabelBox>>& candidates, const MapLayout& layout);
+
 /// The cells of `arrival` reached at or before `time` (1) or not (0), in the raster's order (row 0
 /// north); NaN and NODATA cells never are.
 std::vector<char> burnt_cells(const HeightGrid& arrival, double time);
@@ -111,9 +132,9 @@ std::vector<char> burnt_cells(const HeightGrid& arrival, double time);
 void draw_fire_map(const std::filesystem::path& png, const SurfaceMesh& mesh, const MapLayers& layers,
                    const MapOptions& options = {});
 
-/// What a finished run directory holds for a map: final.mesh, arrival_time.asc when present (its
-/// .prj gives the coordinate system's name), and the centres of case.toml's [region] disks as the
-/// ignition points. InputError naming the missing file.
+/// What a finished run directory holds for a map: final.mesh, arrival_time.tif or .asc when
+/// present (with the coordinate system's name), the ignition points (the centres of case.toml's
+/// [region] disks, or the arrival time's ignition plateaus for other shapes) and [time] start. InputError naming the missing file.
 struct RunMap {
   SurfaceMesh mesh;
   MapLayers layers;

@@ -50,6 +50,11 @@ double signed_distance_to_polygon(const PlanPolygon& polygon, double x, double y
 /// each given to the smallest outer ring that contains it. Meant for height fields (terrains), whose
 /// projection is one-to-one; coordinates are the vertices' x and y.
 std::vector<PlanPolygon> region_outline(const SurfaceMesh& mesh, int region = kInside);
+/// Which cells of a grid have their centre inside the polygons (even-odd over every ring, so holes
+/// are out): cell-centred, `cols` × `rows` cells of `cell_size`, (x_origin, y_origin) the lower-left
+/// corner, rows from north (row 0) to south, as GridField. One scanline per row.
+std::vector<bool> cells_inside(const std::vector<PlanPolygon>& polygons, std::size_t cols, std::size_t rows,
+                               double x_origin, double y_origin, double cell_size);
 /// Σ over the faces labelled `region` of their projected (x, y) areas.
 double region_plan_area(const SurfaceMesh& mesh, int region = kInside);
 

@@ -40,6 +40,13 @@ struct VectorLayer {
 /// OGR cannot read it, it has no such layer, or bodyfit was built without GDAL.
 VectorLayer read_vector_layer(const std::filesystem::path& file, const std::string& name = "");
 
+/// The layer in the surface's coordinate system, as every layer of a case is taken: in place when
+/// the case reprojected its DEM and the layer is in the DEM's geographic system (degrees), as is
+/// when it is in the surface's (a warning when the layer has none: its coordinates are taken as
+/// the surface's); otherwise an InputError naming the file, its system and the surface's.
+void to_surface_crs(VectorLayer& layer, const std::filesystem::path& file, const std::string& surface_crs,
+                    const std::string& reprojected_from, const std::filesystem::path& surface_file);
+
 /// Write a layer of polygons (each feature a MultiPolygon; every feature has the attributes of the
 /// first, in its order and types) as a GeoPackage (.gpkg) or GeoJSON (.geojson/.json), with its
 /// CRS, atomically. Throws InputError for another extension or features that are not polygons,
