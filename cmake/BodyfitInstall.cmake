@@ -32,12 +32,14 @@ foreach(pc bodyfit bodyfit-app)
   install(FILES ${PROJECT_BINARY_DIR}/${pc}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 endforeach()
 
-# What users need beside the programs: the example cases with their DEMs and parts, the example
+# What users need beside the programs: the example cases with their DEMs and parts, the fuel
+# tables the fire model compiles in (to copy and edit), the example
 # plugins (share/bodyfit, where `bodyfit --help` points), the manual and the licences
 # (share/doc/bodyfit), the man page and the bash completion the driver writes of itself.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/meshes/cases ${PROJECT_SOURCE_DIR}/meshes/dem ${PROJECT_SOURCE_DIR}/meshes/parts
                   ${PROJECT_SOURCE_DIR}/examples
         DESTINATION ${CMAKE_INSTALL_DATADIR}/bodyfit)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/plugins/fire/fuels DESTINATION ${CMAKE_INSTALL_DATADIR}/bodyfit)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR})
 install(FILES ${PROJECT_SOURCE_DIR}/plugins/thermal/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR}

@@ -178,7 +178,7 @@ TEST_CASE("wind series errors name the file and the line") {
   CHECK(error_of("time,speed,direction_deg\n0,-1,90\n") == at + ":2: speed: -1 is negative (m/s, expected ≥ 0)");
   CHECK(error_of("time,u,v\nnoon,1,1\n").starts_with(at + ":2: time: 'noon' is neither a number"));
   CHECK(error_of("time,u,v\n0,1,1\n2026-07-14T13:00:00Z,1,1\n").starts_with(at + ":3: time: '2026-07-14T13:00:00Z' is a date-time"));
-  CHECK(error_of("time,u,v\n") == at + ":1: no row after the header: expected one row per time");
+  CHECK(error_of("time,u,v\n") == at + ":1: no row after the header (expected time,speed,direction_deg or time,u,v)");
   CHECK(error_of("").starts_with(at + ": no header line"));
   CHECK(error_of("time,u,u\n").starts_with(at + ":1: the header 'time,u,u' has an empty or repeated column"));
   // The case's keys: a series needs its file, which only a series takes.

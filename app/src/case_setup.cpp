@@ -231,7 +231,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.distance = config.distance;
   options.advection = config.advection;
   options.discretize = config.discretize;
-  options.height_field = config.surface.kind == SurfaceSpec::Kind::Terrain;
+  options.height_field = config.surface.height_field();
   options.clock_start = config.time.start_seconds;
   if (config.region.kind == RegionSpec::Kind::Ignitions)
     for (auto& ignition : read_ignitions(config))

@@ -16,7 +16,7 @@ LoadedModel load_case_model(const CaseConfig& config) {
 Run::Run(CaseConfig config, const std::filesystem::path& output_dir)
     : config_(std::move(config)), model_(load_case_model(config_)), setup_(setup_case(config_)) {
   setup_.options.output_dir = output_dir;
-  setup_.options.height_field = config_.surface.kind == SurfaceSpec::Kind::Terrain;
+  setup_.options.height_field = config_.surface.height_field();
 }
 
 GuardedModel& Run::guarded(int start) {

@@ -4,6 +4,8 @@
 #include "balbi.hpp"
 #include "barriers.hpp"
 #include "fire_maps.hpp"
+#include "fuel.hpp"
+#include "rothermel.hpp"
 #include "wind.hpp"
 
 #include <bodyfit/app/clock_time.hpp>
@@ -26,6 +28,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <unordered_map>
 
 namespace bodyfit::fire {
 namespace {
@@ -115,12 +118,17 @@ class FireModel final : public VelocityModel {
   std::string_view name() const override { return "fire"; }
   std::string_view version() const override { return "1.0"; }
   std::string_view description() const override {
-    return "Balbi et al. (2009) rate of spread from slope, wind and front orientation (paper §4.3); "
-           "SI units: metres, seconds";
+    return "wildfire spread on a terrain: Balbi et al. (2009) rate of spread from slope, wind and front "
+           "orientation (paper §4.3), or Rothermel (1972) with standard fuel models, moistures and the fire "
+           "ellipse; SI units: metres, seconds";
   }
 
   std::vector<ParameterDecl> parameters() const override {
     std::vector<ParameterDecl> declared = {
+        ParameterDecl::choice("spread", {"balbi", "rothermel"},
+                              "the rate of spread: balbi (the paper's, from the preset or R0, A, u0, v0) or rothermel "
+                              "(fuel models of a fuel table, [model.moisture], the elliptical fire shape)")
+            .fallback("balbi"),
         ParameterDecl::choice("preset", {"balbi2009", "paper_table1"},
                               "fuel parameter set: balbi2009 (R0 0.398 m/s, A 1.873) or paper_table1 (R0 2.7 m/s, A 1.25)")
             .fallback("balbi2009"),
@@ -140,8 +148,15 @@ class FireModel final : public VelocityModel {
                               "surface: the slope from the input surface's smooth normal, one field whatever the "
                               "mesh; mesh: from the current mesh's vertex normals, which change with every remesh")
             .fallback("surface"),
-        ParameterDecl::path("fuel.map", "raster of fuel codes: k ≥ 1 = fuel.presets[k−1]; 0, NODATA and "
-                                        "fuel.non_burnable do not burn"),
+        ParameterDecl::path("fuel.map", "raster of fuel codes: balbi: k ≥ 1 = fuel.presets[k−1]; rothermel: the "
+                                        "fuel table's codes; 0, NODATA and fuel.non_burnable do not burn"),
+        ParameterDecl::choice("fuel.table", builtin_fuel_tables(),
+                              "rothermel: the fuel models, Scott & Burgan (2005) 40 or Anderson (1982) 13")
+            .fallback("scott_burgan40"),
+        ParameterDecl::path("fuel.table_file", "rothermel: a fuel table of your own (CSV with units in the header, "
+                                               "docs/reference/fire_model.md \"Fuel tables\"), instead of fuel.table"),
+        ParameterDecl::string("fuel.model", "rothermel: the fuel model everywhere, by code or name (\"GR2\", \"102\"), "
+                                            "without a fuel.map"),
         ParameterDecl::strings("fuel.presets", "parameter sets of the codes of fuel.map (default: [preset])"),
         ParameterDecl::numbers("fuel.non_burnable", 0, "", "more codes of fuel.map that do not burn (water, rock, e.g. "
                                                             "[98, 99])")
@@ -166,7 +181,11 @@ class FireModel final : public VelocityModel {
             .fallback(0.0)
             .at_least(0),
     };
+    declared.push_back(ParameterDecl::boolean("limit_effective_wind", "rothermel: cap the effective wind at 0.9 × the "
+                                                                     "reaction intensity (Rothermel 1972), as BehavePlus")
+                           .fallback(true));
     for (ParameterDecl& d : wind_parameters()) declared.push_back(std::move(d));
+    for (ParameterDecl& d : moisture_parameters()) declared.push_back(std::move(d));
     return declared;
   }
 
@@ -187,6 +206,10 @@ class FireModel final : public VelocityModel {
         OutputDecl::grid("rate_of_spread", "m/s", "the rate of spread at which each cell burnt (terrains)")
             .combine(Combine::mean("ros_mean", "m/s", "rate of spread at which the cell burnt, mean over the members "
                                                       "that burnt it (cells burning at the start have none)")),
+        OutputDecl::grid("fireline_intensity", "kW/m",
+                         "rothermel: Byram's fireline intensity at which each cell burnt (heat per unit area × rate)"),
+        OutputDecl::grid("flame_length", "m", "rothermel: Byram's flame length at which each cell burnt"),
+        OutputDecl::grid("heat_per_unit_area", "kJ/m²", "rothermel: the heat each burnt cell released per unit area"),
         OutputDecl::value("burnt_area", "m²", "|G| at the end: the area burnt, on the surface"),
         OutputDecl::file("perimeters.gpkg", "the burnt region's outline (perimeters.file)"),
         OutputDecl::file("perimeters.geojson", "the same as GeoJSON (perimeters.file)"),
@@ -197,51 +220,38 @@ class FireModel final : public VelocityModel {
   void set_surface(const SurfaceSource& source) override { surface_ = source; }
 
   void configure(Parameters& p) override {
-    const std::string preset_name = p.choice("preset");
-    base_ = preset(preset_name);
-    base_.u0 = p.number("u0");
-    base_.max_tilt = p.number("max_tilt_deg") * kDegree;
+    rothermel_ = p.choice("spread") == "rothermel";
     huygens_ = p.choice("front_velocity") == "huygens";
     surface_slope_ = p.choice("slope") == "surface";
 
-    if (p.has("wind"))
-      wind_ = read_wind_table(p.section("wind"), [&](const std::filesystem::path& file) {
+    wind_height_ = WindHeight::midflame;
+    if (p.has("wind")) {
+      Parameters& w = p.section("wind");
+      wind_ = read_wind_table(w, [&](const std::filesystem::path& file) {
         return read_model_raster(file, Resampling::bilinear);
       });
-    fuels_.clear();
+      parse_wind_height(w.choice("height"), wind_height_);
+      if (!rothermel_ && wind_height_ != WindHeight::midflame)
+        w.fail("height", "spread = \"balbi\" takes the wind at the flame (midflame): its fuel has no bed depth "
+                         "to bring another height down to it");
+    }
+    fuel_map_ = HeightGrid();
+    fuel_file_.clear();
+    non_burnable_.clear();
+    if (rothermel_) configure_rothermel(p);
+    else configure_balbi(p);
     if (p.has("fuel")) {
-      // Each fuel class is a preset: R0, A and v0 come from it, not from [model].
-      for (const char* key : {"R0", "A", "v0"})
-        p.not_used(key, fmt::format("{} is set per fuel class by [model.fuel] presets; give it in the fuel table", key));
       Parameters& f = p.section("fuel");
-      const std::filesystem::path map = f.path("map");
-      std::vector<std::string> names = f.strings("presets");
-      if (names.empty()) names.push_back(preset_name);
-      for (auto& n : names) {
-        try {
-          BalbiParameters q = preset(n);
-          q.max_tilt = base_.max_tilt;
-          q.u0 = base_.u0;
-          fuels_.push_back(q);
-        } catch (const std::invalid_argument& e) {
-          f.fail("presets", e.what());
-        }
-      }
-      non_burnable_.clear();
       for (double code : f.numbers("non_burnable")) {
         if (code != std::round(code) || std::abs(code) > 1e15)
           f.fail("non_burnable", fmt::format("{} is not an integer fuel code", code));
         non_burnable_.push_back(std::llround(code));
       }
-      fuel_file_ = map;
-      if (!map.empty()) {
-        fuel_map_ = read_model_raster(map, Resampling::nearest);
+      fuel_file_ = f.path("map");
+      if (!fuel_file_.empty()) {
+        fuel_map_ = read_model_raster(fuel_file_, Resampling::nearest);
         check_fuel_codes();
       }
-    } else {
-      base_.R0 = p.number("R0", base_.R0);
-      base_.A = p.number("A", base_.A);
-      base_.v0 = p.number("v0", 12 * base_.R0);
     }
     if (p.has("arrival")) {
       Parameters& a = p.section("arrival");
@@ -310,11 +320,17 @@ class FireModel final : public VelocityModel {
       if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
       mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
     }
+    if (rothermel_) update_spreads(mesh, normals, active, time);
     auto rate_in = [&](int v, const Vec3& n_sigma) {
       if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
+      if (rothermel_) {
+        const HeadSpread& spread = spreads_[std::size_t(v)];
+        return n_sigma.sqrnorm() == 0 ? spread.flank : ellipse_normal_rate(spread, n_sigma);
+      }
       const Vec3& x = mesh.point(VertexHandle(v));
-      const BalbiParameters* fuel = fuel_at(x);
-      if (!fuel) return 0.0;  // not burnable: the front stops here
+      const int index = fuel_at(x[0], x[1]);
+      if (index < 0) return 0.0;  // not burnable: the front stops here
+      const BalbiParameters* fuel = &balbi_fuel(index);
       if (n_sigma.sqrnorm() == 0) return fuel->R0;
       const Vec3& normal = normals[v];
       // ∇_S s · n_Σ = e3 · n_Σ because n_Σ is tangent (∇_S s = e3 − (e3·N)N).
@@ -440,9 +456,11 @@ class FireModel final : public VelocityModel {
       outputs.grid("arrival_time", grid_field(arrival_.grid(), "fire arrival time, seconds " + since, items, crs_));
       outputs.grid("rate_of_spread",
                    grid_field(arrival_.rate_grid(),
-                              "rate of spread (Balbi) at which the cell burnt, m/s (NODATA: not reached, or burning at "
-                              "the start)",
+                              fmt::format("rate of spread ({}) at which the cell burnt, m/s (NODATA: not reached, or "
+                                          "burning at the start)",
+                                          rothermel_ ? "Rothermel" : "Balbi"),
                               items, crs_));
+      if (rothermel_) write_intensity_grids(outputs, items);
     }
     if (output_dir.empty()) return;
     write_perimeters(output_dir);
@@ -466,6 +484,75 @@ class FireModel final : public VelocityModel {
   }
 
  private:
+  // Balbi's parameters: the preset's, or per fuel class of the fuel map; Rothermel's keys refused.
+  void configure_balbi(Parameters& p) {
+    p.forbid({"moisture", "limit_effective_wind"}, "to spread = \"balbi\" (Rothermel's: set spread = \"rothermel\")");
+    const std::string preset_name = p.choice("preset");
+    base_ = preset(preset_name);
+    base_.u0 = p.number("u0");
+    base_.max_tilt = p.number("max_tilt_deg") * kDegree;
+    fuels_.clear();
+    if (!p.has("fuel")) {
+      base_.R0 = p.number("R0", base_.R0);
+      base_.A = p.number("A", base_.A);
+      base_.v0 = p.number("v0", 12 * base_.R0);
+      return;
+    }
+    // Each fuel class is a preset: R0, A and v0 come from it, not from [model].
+    for (const char* key : {"R0", "A", "v0"})
+      p.not_used(key, fmt::format("{} is set per fuel class by [model.fuel] presets; give it in the fuel table", key));
+    Parameters& f = p.section("fuel");
+    f.forbid({"table", "table_file", "model"}, "to spread = \"balbi\" (fuel tables are Rothermel's: fuel.presets "
+                                               "name Balbi's parameter sets)");
+    std::vector<std::string> names = f.strings("presets");
+    if (names.empty()) names.push_back(preset_name);
+    for (auto& n : names) {
+      try {
+        BalbiParameters q = preset(n);
+        q.max_tilt = base_.max_tilt;
+        q.u0 = base_.u0;
+        fuels_.push_back(q);
+      } catch (const std::invalid_argument& e) {
+        f.fail("presets", e.what());
+      }
+    }
+  }
+
+  // Rothermel's fuel beds: the fuel table's models under the case's moistures; Balbi's keys refused.
+  void configure_rothermel(Parameters& p) {
+    p.forbid({"preset", "R0", "A", "u0", "v0", "max_tilt_deg"},
+             "to spread = \"rothermel\" (Balbi's parameters: Rothermel's come from the fuel table)");
+    spread_options_.limit_effective_wind = p.boolean("limit_effective_wind");
+    moisture_ = read_moisture(p.section("moisture"));
+    Parameters& f = p.section("fuel");
+    f.forbid({"presets"}, "to spread = \"rothermel\" (Balbi's parameter sets: Rothermel's fuels are the table's)");
+    if (f.has("table_file")) {
+      if (f.has("table")) f.fail("table", "give either fuel.table or fuel.table_file");
+      table_ = read_fuel_table(f.path("table_file"));
+    } else {
+      table_ = fuel_table(f.choice("table"));
+    }
+    beds_.clear();
+    code_index_.clear();
+    if (f.has("model") == f.has("map"))
+      f.fail("expected either fuel.model (one fuel everywhere, e.g. \"GR2\") or fuel.map (a raster of the fuel "
+             "table's codes)");
+    auto add_bed = [&](const FuelModel& m) {
+      code_index_[m.code] = int(beds_.size());
+      beds_.push_back(surface_fire(m, moisture_));
+      const SurfaceFire& bed = beds_.back();
+      if (!bed.extinct.empty() && m.burnable()) spdlog::warn("{}", bed.extinct);
+    };
+    if (f.has("model")) {
+      const std::string name = f.string("model");
+      const FuelModel* m = table_.find(name);
+      if (!m) f.fail("model", fmt::format("'{}' is not a model of the fuel table {}", name, table_.source));
+      add_bed(*m);
+    } else {
+      for (const FuelModel& m : table_.models) add_bed(m);
+    }
+  }
+
   // The state's outline, once per iteration (sub-steps and retried steps compute on the same
   // state); kept when it is a perimeters.every-th state, and always as the latest (the final state
   // is the last one computed: finish() adds it).
@@ -533,38 +620,104 @@ class FireModel final : public VelocityModel {
     return code == 0 || std::find(non_burnable_.begin(), non_burnable_.end(), code) != non_burnable_.end();
   }
 
-  // Every cell of the fuel map is NODATA, a non-burnable code or the number of a preset: any other
-  // value is an error naming its cell (before, codes without a preset silently did not burn).
+  // Every cell of the fuel map is NODATA, a non-burnable code or a fuel's code (balbi: a preset's
+  // number; rothermel: a code of the fuel table): any other value is an error naming its cell.
   void check_fuel_codes() const {
     for (std::size_t row = 0; row < fuel_map_.rows; ++row)
       for (std::size_t col = 0; col < fuel_map_.cols; ++col) {
         if (!fuel_map_.valid(row, col)) continue;
         const double value = fuel_map_.at(row, col);
         const bool integer = value == std::round(value) && std::abs(value) < 1e15;
-        if (integer && (non_burnable(std::llround(value)) || (value >= 1 && value <= double(fuels_.size())))) continue;
-        throw InputError(fmt::format("{}: the fuel code {} of the cell at row {}, column {} is neither a preset's number "
-                                     "(1 to {}: [model.fuel] presets) nor 0, NODATA ({}) or a code of [model.fuel] "
-                                     "non_burnable",
-                                     fuel_file_.string(), value, row + 1, col + 1, fuels_.size(), fuel_map_.nodata));
+        if (integer && (non_burnable(std::llround(value)) || fuel_of_code(std::llround(value)) >= 0)) continue;
+        const std::string fuels =
+            rothermel_ ? fmt::format("a code of the fuel table {}", table_.source)
+                       : fmt::format("a preset's number (1 to {}: [model.fuel] presets)", fuels_.size());
+        throw InputError(fmt::format("{}: the fuel code {} of the cell at row {}, column {} is neither {} nor 0, NODATA "
+                                     "({}) or a code of [model.fuel] non_burnable",
+                                     fuel_file_.string(), value, row + 1, col + 1, fuels, fuel_map_.nodata));
       }
   }
 
-  // Fuel at a point: the uniform fuel, or the map's code (NODATA, 0 and the non-burnable codes → null).
-  const BalbiParameters* fuel_at(const Vec3& x) const {
-    if (fuel_map_.cols == 0) return fuels_.empty() ? &base_ : &fuels_.front();
-    const double value = raster_nearest(fuel_map_, x[0], x[1]);
-    if (std::isnan(value) || value == fuel_map_.nodata) return nullptr;  // no data is no fuel
+  // The fuel of a code of the map: an index into fuels_ (balbi) or beds_ (rothermel), −1 for none.
+  int fuel_of_code(long long code) const {
+    if (rothermel_) {
+      const auto it = code_index_.find(code);
+      return it == code_index_.end() ? -1 : it->second;
+    }
+    return code >= 1 && std::size_t(code) <= fuels_.size() ? int(code - 1) : -1;
+  }
+
+  // The fuel at a point: the uniform one, or the map's code (NODATA, 0 and the non-burnable codes: −1).
+  int fuel_at(double x, double y) const {
+    if (fuel_map_.cols == 0) return 0;
+    const double value = raster_nearest(fuel_map_, x, y);
+    if (std::isnan(value) || value == fuel_map_.nodata) return -1;  // no data is no fuel
     const long long code = std::llround(value);
-    if (non_burnable(code) || code < 1 || std::size_t(code) > fuels_.size()) return nullptr;
-    return &fuels_[std::size_t(code) - 1];
+    return non_burnable(code) ? -1 : fuel_of_code(code);
+  }
+  const BalbiParameters& balbi_fuel(int index) const { return fuels_.empty() ? base_ : fuels_[std::size_t(index)]; }
+
+  // Rothermel's fire ellipse at the vertices R is needed at (the band's, or all): fuel, slope and
+  // wind are the vertex's, the direction of the front is applied by ellipse_normal_rate.
+  void update_spreads(const SurfaceMesh& mesh, const VectorField& normals, std::span<const int> active, double time) {
+    spreads_.resize(mesh.n_vertices());
+    auto update = [&](int v) {
+      const Vec3& x = mesh.point(VertexHandle(v));
+      const int fuel = fuel_at(x[0], x[1]);
+      if (fuel < 0) {
+        spreads_[std::size_t(v)] = HeadSpread{};
+        return;
+      }
+      const SurfaceFire& bed = beds_[std::size_t(fuel)];
+      spreads_[std::size_t(v)] = head_spread_on_terrain(bed, normals[v], wind_.at(x, time),
+                                                        midflame_factor(wind_height_, bed.depth), spread_options_);
+    };
+    if (!active.empty())
+      for (int v : active) update(v);
+    else
+      for (int v = 0; v < int(mesh.n_vertices()); ++v) update(v);
+  }
+
+  // Byram's fireline intensity, flame length and the heat per unit area of the cells that burnt,
+  // from the rate each burnt at and the fuel of its centre.
+  void write_intensity_grids(ModelOutputs& outputs, const std::vector<std::pair<std::string, std::string>>& items) const {
+    const HeightGrid& rate = arrival_.rate_grid();
+    HeightGrid heat = rate, intensity = rate, flame = rate;
+    for (std::size_t row = 0; row < rate.rows; ++row)
+      for (std::size_t col = 0; col < rate.cols; ++col) {
+        const std::size_t cell = row * rate.cols + col;
+        if (!rate.valid(row, col)) {
+          heat.heights[cell] = intensity.heights[cell] = flame.heights[cell] = rate.nodata;
+          continue;
+        }
+        const double x = rate.x_origin + (double(col) + 0.5) * rate.cell_size;
+        const double y = rate.y_origin + (double(rate.rows - row) - 0.5) * rate.cell_size;
+        const int fuel = fuel_at(x, y);
+        const double h = fuel < 0 ? 0.0 : beds_[std::size_t(fuel)].heat_per_unit_area;
+        heat.heights[cell] = h;
+        intensity.heights[cell] = fireline_intensity(h, rate.at(row, col));
+        flame.heights[cell] = flame_length(intensity.heights[cell]);
+      }
+    outputs.grid("heat_per_unit_area", grid_field(heat, "heat per unit area released, kJ/m² (Rothermel)", items, crs_));
+    outputs.grid("fireline_intensity",
+                 grid_field(intensity, "Byram's fireline intensity at which the cell burnt, kW/m", items, crs_));
+    outputs.grid("flame_length", grid_field(flame, "Byram's flame length at which the cell burnt, m", items, crs_));
   }
 
   SurfaceSource surface_;  ///< what S was built from (set_surface): its CRS is the case's
   Barriers barriers_;
   double barrier_reach_ = 0;   ///< of the state's own compute (barrier_reach)
   std::vector<char> stopped_;  ///< 1 at the vertices a barrier blocks
+  bool rothermel_ = false;  ///< spread: Rothermel's ellipse (true) or Balbi's (4.8)
   BalbiParameters base_;
   std::vector<BalbiParameters> fuels_;
+  FuelTable table_;                              ///< rothermel: the fuel models
+  FuelMoisture moisture_;                        ///< rothermel: [model.moisture]
+  std::vector<SurfaceFire> beds_;                ///< rothermel: the fuel beds under moisture_
+  std::unordered_map<long long, int> code_index_;  ///< rothermel: fuel code → beds_ index
+  SpreadOptions spread_options_;
+  WindHeight wind_height_ = WindHeight::midflame;
+  std::vector<HeadSpread> spreads_;              ///< rothermel: the ellipse at the vertices (update_spreads)
   std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA
   HeightGrid fuel_map_;
   WindField wind_;

@@ -1,5 +1,7 @@
 #include "wind.hpp"
 
+#include "csv_table.hpp"
+
 #include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/parameters.hpp>
@@ -26,94 +28,6 @@ constexpr double kDegree = M_PI / 180.0;
 Vec3 wind_from_direction(double speed, double direction_deg) {
   const double from = direction_deg * kDegree;
   return Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
-}
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-struct CsvRow {
-  long line = 0;
-  std::vector<std::string> fields;
-};
-
-/// A CSV with a header line: comma-separated fields, surrounding blanks trimmed; blank lines and
-/// lines starting with '#' skipped.
-struct Csv {
-  std::filesystem::path file{};
-  long header_line = 0;
-  std::vector<std::string> columns{};
-  std::vector<CsvRow> rows{};
-
-  /// The column's index, or columns.size() when absent.
-  std::size_t column(std::string_view name) const {
-    return std::size_t(std::find(columns.begin(), columns.end(), name) - columns.begin());
-  }
-  bool has(std::string_view name) const { return column(name) < columns.size(); }
-};
-
-std::vector<std::string> split_fields(std::string_view text) {
-  std::vector<std::string> fields;
-  while (true) {
-    const std::size_t comma = text.find(',');
-    fields.emplace_back(trim(text.substr(0, comma)));
-    if (comma == std::string_view::npos) return fields;
-    text.remove_prefix(comma + 1);
-  }
-}
-
-Csv read_csv(const std::filesystem::path& file, std::string_view expected) {
-  std::ifstream in(file);
-  if (!in) throw file_error(file, fmt::format("cannot open the wind series (expected a CSV file: {})", expected));
-  Csv csv{.file = file};
-  std::string text;
-  for (long line = 1; std::getline(in, text); ++line) {
-    std::string_view view = text;
-    if (line == 1 && view.starts_with("\xEF\xBB\xBF")) view.remove_prefix(3);  // a spreadsheet's BOM
-    view = trim(view);
-    if (view.empty() || view.front() == '#') continue;
-    std::vector<std::string> fields = split_fields(view);
-    if (csv.columns.empty()) {
-      for (const auto& name : fields)
-        if (name.empty() || std::count(fields.begin(), fields.end(), name) > 1)
-          throw file_error(file, line, fmt::format("the header '{}' has an empty or repeated column name (expected {})",
-                                                   view, expected));
-      csv.columns = std::move(fields);
-      csv.header_line = line;
-      continue;
-    }
-    if (fields.size() != csv.columns.size())
-      throw file_error(file, line, fmt::format("{} field(s), the header has {} ({})", fields.size(), csv.columns.size(),
-                                               fmt::join(csv.columns, ",")));
-    csv.rows.push_back({line, std::move(fields)});
-  }
-  if (csv.columns.empty()) throw file_error(file, fmt::format("no header line (expected {})", expected));
-  if (csv.rows.empty()) throw file_error(file, csv.header_line, "no row after the header: expected one row per time");
-  return csv;
-}
-
-/// The columns must be exactly `required` (in any order).
-void require_columns(const Csv& csv, const std::vector<std::string_view>& required, std::string_view expected) {
-  for (const auto& name : csv.columns)
-    if (std::find(required.begin(), required.end(), name) == required.end())
-      throw file_error(csv.file, csv.header_line, fmt::format("unknown column '{}' (expected {})", name, expected));
-  for (std::string_view name : required)
-    if (!csv.has(name))
-      throw file_error(csv.file, csv.header_line, fmt::format("no column '{}' (expected {})", name, expected));
-}
-
-double finite_number(const Csv& csv, const CsvRow& row, std::string_view column) {
-  std::string_view text = row.fields[csv.column(column)];
-  if (text.starts_with('+')) text.remove_prefix(1);
-  double value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size() || text.empty())
-    throw file_error(csv.file, row.line, fmt::format("{}: '{}' is not a number", column, row.fields[csv.column(column)]));
-  if (!std::isfinite(value))
-    throw file_error(csv.file, row.line, fmt::format("{}: {} is not a finite number", column, text));
-  return value;
 }
 
 /// The times of the rows: seconds after t = 0, or ISO 8601 date-times (seconds since the epoch),
@@ -168,7 +82,7 @@ HeightGrid read_wind_raster(const std::filesystem::path& file, const RasterReade
 
 WindSeries read_wind_series(const std::filesystem::path& file) {
   constexpr std::string_view expected = "time,speed,direction_deg or time,u,v";
-  const Csv csv = read_csv(file, expected);
+  const Csv csv = read_csv(file, "the wind series", expected);
   const bool components = csv.has("u") || csv.has("v");
   if (components) require_columns(csv, {"time", "u", "v"}, expected);
   else require_columns(csv, {"time", "speed", "direction_deg"}, expected);
@@ -188,7 +102,7 @@ WindSeries read_wind_series(const std::filesystem::path& file) {
 
 WindSeries read_wind_grid_series(const std::filesystem::path& file, const RasterReader& read) {
   constexpr std::string_view expected = "time,u_file,v_file";
-  const Csv csv = read_csv(file, expected);
+  const Csv csv = read_csv(file, "the wind series", expected);
   require_columns(csv, {"time", "u_file", "v_file"}, expected);
   WindSeries series{.file = file};
   read_times(csv, series);
@@ -281,6 +195,10 @@ std::vector<ParameterDecl> wind_parameters() {
       ParameterDecl::path("wind.file", "series: CSV time,speed,direction_deg or time,u,v; grid_series: CSV "
                                        "time,u_file,v_file (rasters relative to it); times in s after t = 0 or ISO "
                                        "8601 ([time] start); linear in time on (u, v), the end values held outside"),
+      ParameterDecl::choice("wind.height", {"midflame", "20ft", "10m"},
+                            "the height the wind is given at: midflame, or 20 ft / 10 m above the vegetation "
+                            "(spread = \"rothermel\": brought to midflame by the fuel's wind adjustment factor)")
+          .fallback("midflame"),
   };
 }
 

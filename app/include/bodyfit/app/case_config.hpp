@@ -53,6 +53,10 @@ struct SurfaceSpec {
   NodataMode nodata = NodataMode::hole;      ///< with `dem`: what its NODATA cells become
   Reprojection reproject = Reprojection::none;  ///< with `dem`: a raster in degrees refused, or warped to UTM
   PlaneOptions plane;               ///< Kind::Plane
+
+  /// A terrain or the plane z = 0: a height field z(x, y) (StepContext::is_height_field), on
+  /// which the fire model keeps its arrival-time raster and perimeters.
+  bool height_field() const { return kind == Kind::Terrain || kind == Kind::Plane; }
 };
 
 struct RegionSpec {
