@@ -2,10 +2,12 @@
 // bytes for any scheduling (sequential, threads, MPI ranks), restarts and failing members.
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/app/ensemble.hpp>
+#include <bodyfit/error.hpp>
 
 #include "test_support.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <doctest/doctest.h>
 
@@ -418,4 +420,127 @@ TEST_CASE("ensemble: under MPI, 1 and 2 ranks give the sequential bytes") {
     require_identical(dir / "sequential", out);
   }
 #endif
+}
+
+TEST_CASE("ensemble: a choice among values of any kind, with weights (a wind height, a moisture scenario)") {
+  test::TempDir dir("ensemble_choice");
+  std::ofstream(dir / "case.toml") << R"([surface]
+generator = "plane"
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.1]
+[model]
+name = "fire"
+[ensemble]
+members = 200
+[ensemble.sample]
+"model.wind.height" = {dist = "choice", values = ["midflame", "20ft", "10m"], weights = [2, 1, 1]}
+"model.u0" = {dist = "choice", values = [30.0, 40.0]}
+)";
+  const EnsembleSpec spec = read_ensemble_spec(dir / "case.toml", {});
+  REQUIRE(spec.parameters.size() == 2);
+  PlacementDomain domain;
+  domain.xmax = domain.ymax = 1;
+  std::map<std::string, int> heights;
+  int thirty = 0;
+  for (std::size_t i = 0; i < spec.members; ++i) {
+    const MemberScenario s = sample_member(spec, domain, i);
+    REQUIRE(s.overrides.size() == 3);  // the region, then the parameters in key order
+    for (const std::string& o : s.overrides)
+      if (o.starts_with("model.wind.height=")) ++heights[o];
+    thirty += s.overrides[1] == "model.u0=30.0";
+    CHECK((s.overrides[1] == "model.u0=30.0" || s.overrides[1] == "model.u0=40.0"));
+  }
+  // Weights 2:1:1 over 200 members, equal weights over two values (binomial: ±4 sd).
+  CHECK(heights.size() == 3);
+  CHECK(std::abs(heights["model.wind.height='midflame'"] - 100) < 29);
+  CHECK(std::abs(heights["model.wind.height='20ft'"] - 50) < 25);
+  CHECK(std::abs(thirty - 100) < 29);
+  // Bad choices: no values, a table among them, weights of another length.
+  auto error_of = [&](const std::string& sample) {
+    std::ofstream(dir / "bad.toml") << "[surface]\ngenerator = \"plane\"\n[model]\nname = \"fire\"\n[ensemble.sample]\n" << sample;
+    try {
+      read_ensemble_spec(dir / "bad.toml", {});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(error_of("\"model.u0\" = {dist = \"choice\"}\n").find("expected a non-empty array") != std::string::npos);
+  CHECK(error_of("\"model.u0\" = {dist = \"choice\", values = [{a = 1}]}\n").find("expected strings, numbers or booleans") != std::string::npos);
+  CHECK(error_of("\"model.u0\" = {dist = \"choice\", values = [1.0, 2.0], weights = [1.0]}\n") != "no error");
+  CHECK(error_of("\"model.u0\" = {dist = \"choice\", values = [1.0, 2.0], weights = [0.0, 0.0]}\n").find("positive sum") != std::string::npos);
+}
+
+TEST_CASE("ensemble: sampling only a fuel moisture gives members of different areas; a fixed one, equal areas") {
+  // Rothermel's GR2 on flat ground: where a member's fire starts does not change its area, what it
+  // burns with does.
+  const std::string base = R"([surface]
+generator = "plane"
+size = 1200.0
+h = 40.0
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [60.0]
+[model]
+name = "fire"
+spread = "rothermel"
+[model.fuel]
+model = "GR2"
+[model.wind]
+type = "uniform"
+speed = 3.0
+direction_deg = 270.0
+height = "20ft"
+[model.arrival]
+cell_size = 40.0
+[time]
+dt = 300.0
+final_time = 1200.0
+[output]
+vtu_every = 0
+[ensemble]
+members = 4
+seed = 5
+[ensemble.region]
+polygon = [[-200.0, -200.0], [200.0, -200.0], [200.0, 200.0], [-200.0, 200.0]]
+radius = 60.0
+[model.moisture]
+dead_10h = 7.0
+dead_100h = 8.0
+live_herb = 60.0
+live_woody = 90.0
+)";
+  auto areas = [&](const std::string& name, const std::string& more) {
+    TempDir dir(name);
+    const fs::path file = write_case(dir, base + more);
+    ensemble(file, dir / "out");
+    std::ifstream table(dir / "out/members.csv");
+    std::string header, row;
+    std::getline(table, header);
+    const auto columns = [](const std::string& line) {
+      std::vector<std::string> cells;
+      std::stringstream s(line);
+      for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+      return cells;
+    };
+    const std::vector<std::string> names = columns(header);
+    const std::size_t at = std::size_t(std::find(names.begin(), names.end(), "burnt_area_m2") - names.begin());
+    REQUIRE(at < names.size());
+    std::vector<double> result;
+    while (std::getline(table, row)) result.push_back(std::stod(columns(row)[at]));
+    REQUIRE(result.size() == 4);
+    return result;
+  };
+  // dead_1h given in the case: every member burns the same area, wherever it starts (to the
+  // remesher's noise).
+  const std::vector<double> fixed = areas("ensemble_moisture_fixed", "dead_1h = 6.0\n");
+  for (double a : fixed) CHECK(a == doctest::Approx(fixed[0]).epsilon(0.01));
+  // dead_1h sampled from 3 % to 12 %: the areas spread.
+  const std::vector<double> sampled =
+      areas("ensemble_moisture_sampled", "[ensemble.sample]\n\"model.moisture.dead_1h\" = {dist = \"uniform\", min = 3.0, max = 12.0}\n");
+  const auto [lo, hi] = std::minmax_element(sampled.begin(), sampled.end());
+  CHECK(*hi > 1.2 * *lo);
 }

@@ -97,6 +97,13 @@ std::string column_unit(std::string unit) {
   return unit;
 }
 
+/// A TOML value as a table shows it: a string without its quotes.
+std::string choice_text(const std::string& toml_text) {
+  if (toml_text.size() >= 2 && (toml_text.front() == '"' || toml_text.front() == '\'') && toml_text.back() == toml_text.front())
+    return toml_text.substr(1, toml_text.size() - 2);
+  return toml_text;
+}
+
 void write_member_table(const fs::path& file, const EnsembleRun& run, const std::vector<MemberRecord>& records) {
   write_atomically(file, [&](std::ostream& out) {
     out << "index,status,region_x,region_y";
@@ -111,7 +118,14 @@ void write_member_table(const fs::path& file, const EnsembleRun& run, const std:
     };
     for (const MemberRecord& r : records) {
       out << fmt::format("{},{},{},{}", r.index, r.ok ? "ok" : "failed", r.x, r.y);
-      for (const SampledParameter& p : run.spec.parameters) out << fmt::format(",{}", value_of(r.parameters, p.key));
+      for (const SampledParameter& p : run.spec.parameters) {
+        const double value = value_of(r.parameters, p.key);
+        // A choice shows the value drawn (its index is what the member's record keeps).
+        if (p.distribution == SampledParameter::Distribution::Choice && value >= 0 && value < double(p.choices.size()))
+          out << ',' << csv_text(choice_text(p.choices[std::size_t(value)]));
+        else
+          out << fmt::format(",{}", value);
+      }
       for (const OutputDecl& d : run.values) out << fmt::format(",{}", value_of(r.values, d.name));
       out << fmt::format(",{},{},{},{}\n", r.final_time, r.iterations, csv_text(r.stop), csv_text(r.error));
     }

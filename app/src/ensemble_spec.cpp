@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace bodyfit {
 namespace {
@@ -51,8 +52,28 @@ SampledParameter read_sampled(const std::string& key, const toml::node& node) {
   Parameters p(*t, section);
   SampledParameter s;
   s.key = key;
-  const std::string dist = p.choice("dist", "uniform", {"uniform", "normal", "lognormal"});
-  if (dist == "uniform") {
+  const std::string dist = p.choice("dist", "uniform", {"uniform", "normal", "lognormal", "choice"});
+  if (dist == "choice") {
+    // Values of any TOML kind (a wind height, a fuel model, a number), drawn with their weights.
+    s.distribution = SampledParameter::Distribution::Choice;
+    const toml::array* values = t->get_as<toml::array>("values");
+    if (!values || values->empty())
+      p.fail("values", "expected a non-empty array of the values to choose from, e.g. values = [\"midflame\", \"20ft\"]");
+    p.accept("values");
+    for (const toml::node& v : *values) {
+      if (!v.is_string() && !v.is_number() && !v.is_boolean())
+        p.fail("values", "expected strings, numbers or booleans");
+      std::ostringstream text;
+      v.visit([&](const auto& value) { text << value; });
+      s.choices.push_back(text.str());
+    }
+    if (t->contains("weights")) {
+      s.weights = p.numbers("weights", {}, values->size(), {.min = 0});
+      double total = 0;
+      for (double w : s.weights) total += w;
+      if (!(total > 0) || !std::isfinite(total)) p.fail("weights", "expected weights ≥ 0 with a positive sum");
+    }
+  } else if (dist == "uniform") {
     s.distribution = SampledParameter::Distribution::Uniform;
     s.a = p.required_number("min");
     s.b = p.required_number("max");
@@ -183,6 +204,16 @@ MemberScenario sample_member(const EnsembleSpec& spec, const PlacementDomain& do
     double value = std::numeric_limits<double>::quiet_NaN();
     if (p.distribution == SampledParameter::Distribution::Uniform) {
       value = p.a + uniform01(spec.seed, index, stream, 0) * (p.b - p.a);
+    } else if (p.distribution == SampledParameter::Distribution::Choice) {
+      std::vector<double> weights = p.weights.empty() ? std::vector<double>(p.choices.size(), 1.0) : p.weights;
+      double total = 0;
+      for (double w : weights) total += w;
+      double u = uniform01(spec.seed, index, stream, 0) * total;
+      std::size_t k = 0;
+      while (k + 1 < weights.size() && u >= weights[k]) u -= weights[k++];
+      s.values.push_back(double(k));
+      s.overrides.push_back(p.key + "=" + p.choices[k]);
+      continue;
     } else {
       // Truncated by redrawing: attempt k uses draws 2k and 2k + 1 of the parameter's stream.
       for (std::uint64_t attempt = 0; attempt < 10000; ++attempt) {

@@ -43,10 +43,14 @@ namespace bodyfit {
 
 /// A case key given a distribution by [ensemble.sample].
 struct SampledParameter {
-  enum class Distribution { Uniform, Normal, LogNormal };
+  enum class Distribution { Uniform, Normal, LogNormal, Choice };
   std::string key;  ///< dotted case key, e.g. "model.wind.speed"
   Distribution distribution = Distribution::Uniform;
   double a = 0, b = 1;  ///< uniform: min, max; normal: mean, sd; lognormal: mu, sigma of ln x
+  /// Choice: the values as TOML text ("\"20ft\"", "6.0"), and their weights (equal when empty).
+  /// A member's drawn value is the index of its choice (members.csv shows the value itself).
+  std::vector<std::string> choices{};
+  std::vector<double> weights{};
   /// Truncation of normal and lognormal draws (redrawn until inside, up to a bound).
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
