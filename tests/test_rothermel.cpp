@@ -2,6 +2,7 @@
 // (BehavePlus's wind adjustment factors), the model's limits and invariants, unit conversions
 // checked in both systems, and the errors of bad fuel tables and moistures.
 #include "fuel.hpp"
+#include "moisture.hpp"
 #include "rothermel.hpp"
 
 #include <bodyfit/error.hpp>
@@ -232,7 +233,7 @@ TEST_CASE("fuel tables and moistures: bad input is an error naming the file, lin
     const toml::table t = toml::parse(text);
     Parameters p(t, moisture_parameters(), "model");
     try {
-      read_moisture(p.section("moisture"));
+      read_moisture(p.section("moisture"));  // constant classes or a scenario here
     } catch (const InputError& e) {
       return e.what();
     }
@@ -244,5 +245,5 @@ TEST_CASE("fuel tables and moistures: bad input is an error naming the file, lin
             .find("0.06 looks like a fraction: moistures are in percent (6 for 6 %)") != std::string::npos);
   CHECK(moisture_error("[moisture]\ndead_1h = 6\n").find("live") == std::string::npos);  // names the missing dead_10h first
   CHECK(moisture_error("[moisture]\ndead_1h = 6\n").find("dead_10h") != std::string::npos);
-  CHECK(moisture_error("[moisture]\nscenario = 'D1L1'\ndead_1h = 6\n").find("not both") != std::string::npos);
+  CHECK(moisture_error("[moisture]\nscenario = 'D1L1'\ndead_1h = 6\n").find("not several") != std::string::npos);
 }

@@ -1,5 +1,6 @@
 #include "csv_table.hpp"
 
+#include <bodyfit/app/clock_time.hpp>
 #include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
@@ -94,6 +95,51 @@ double finite_number(const Csv& csv, const CsvRow& row, std::string_view column)
   if (!std::isfinite(value))
     throw file_error(csv.file, row.line, fmt::format("{}: {} is not a finite number", column, text));
   return value;
+}
+
+std::vector<double> read_series_times(const Csv& csv, bool& clock_times) {
+  std::vector<double> times;
+  for (std::size_t k = 0; k < csv.rows.size(); ++k) {
+    const CsvRow& row = csv.rows[k];
+    const std::string& text = row.fields[csv.column("time")];
+    double time = 0;
+    bool clock = false;
+    if (const std::optional<double> date = parse_iso8601(text)) {
+      time = *date;
+      clock = true;
+    } else {
+      try {
+        time = finite_number(csv, row, "time");
+      } catch (const InputError&) {
+        throw file_error(csv.file, row.line,
+                         fmt::format("time: '{}' is neither a number of seconds after t = 0 nor an ISO 8601 date-time "
+                                     "with its zone (2026-07-14T13:00:00Z)",
+                                     text));
+      }
+    }
+    if (k == 0) clock_times = clock;
+    if (clock != clock_times)
+      throw file_error(csv.file, row.line,
+                       fmt::format("time: '{}' is {}, the first time is {}: give every time the same way", text,
+                                   clock ? "a date-time" : "in seconds", clock ? "in seconds" : "a date-time"));
+    if (k > 0 && !(time > times.back()))
+      throw file_error(csv.file, row.line,
+                       fmt::format("time {} is not after the previous row's (line {}): times must increase", text,
+                                   csv.rows[k - 1].line));
+    times.push_back(time);
+  }
+  return times;
+}
+
+std::vector<double> series_run_times(const std::vector<double>& times, bool clock_times,
+                                     std::optional<double> clock_start, const std::filesystem::path& file) {
+  if (clock_times && !clock_start)
+    throw file_error(file, "its times are ISO 8601 date-times: the case needs [time] start (the date-time of t = 0), "
+                           "or give the times in seconds after t = 0");
+  std::vector<double> run_times = times;
+  if (clock_times)
+    for (double& t : run_times) t -= *clock_start;
+  return run_times;
 }
 
 }  // namespace bodyfit::fire

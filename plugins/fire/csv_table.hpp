@@ -4,6 +4,7 @@
 // InputError "<file>:<line>: …".
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,5 +39,14 @@ void require_columns(const Csv& csv, const std::vector<std::string_view>& requir
 
 /// The row's field in `column` as a finite number (a leading '+' allowed).
 double finite_number(const Csv& csv, const CsvRow& row, std::string_view column);
+
+/// The `time` column of a series: seconds after t = 0, or ISO 8601 date-times (seconds since the
+/// epoch; `clock_times` set), all of one kind, strictly increasing.
+std::vector<double> read_series_times(const Csv& csv, bool& clock_times);
+
+/// Series times on a run's clock: the times as given, or date-times less `clock_start` (the
+/// date-time of t = 0); InputError naming `file` when they are date-times and there is no start.
+std::vector<double> series_run_times(const std::vector<double>& times, bool clock_times,
+                                     std::optional<double> clock_start, const std::filesystem::path& file);
 
 }  // namespace bodyfit::fire

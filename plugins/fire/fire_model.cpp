@@ -5,6 +5,7 @@
 #include "barriers.hpp"
 #include "fire_maps.hpp"
 #include "fuel.hpp"
+#include "moisture.hpp"
 #include "rothermel.hpp"
 #include "wind.hpp"
 
@@ -282,6 +283,8 @@ class FireModel final : public VelocityModel {
     if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
     for (const auto& raster : wind_.rasters()) rasters.push_back(raster);
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
+    if (rothermel_)
+      for (const auto& raster : moisture_.rasters()) rasters.push_back(raster);
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
     std::filesystem::path first_file;
@@ -320,7 +323,10 @@ class FireModel final : public VelocityModel {
       if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
       mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
     }
-    if (rothermel_) update_spreads(mesh, normals, active, time);
+    if (rothermel_) {
+      moisture_.set_clock(context.clock_start());
+      update_spreads(mesh, normals, active, time);
+    }
     auto rate_in = [&](int v, const Vec3& n_sigma) {
       if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
       if (rothermel_) {
@@ -523,7 +529,9 @@ class FireModel final : public VelocityModel {
     p.forbid({"preset", "R0", "A", "u0", "v0", "max_tilt_deg"},
              "to spread = \"rothermel\" (Balbi's parameters: Rothermel's come from the fuel table)");
     spread_options_.limit_effective_wind = p.boolean("limit_effective_wind");
-    moisture_ = read_moisture(p.section("moisture"));
+    moisture_ = read_moisture(p.section("moisture"), [&](const std::filesystem::path& file) {
+      return read_model_raster(file, Resampling::bilinear);
+    });
     Parameters& f = p.section("fuel");
     f.forbid({"presets"}, "to spread = \"rothermel\" (Balbi's parameter sets: Rothermel's fuels are the table's)");
     if (f.has("table_file")) {
@@ -533,13 +541,17 @@ class FireModel final : public VelocityModel {
       table_ = fuel_table(f.choice("table"));
     }
     beds_.clear();
+    models_.clear();
     code_index_.clear();
+    beds_time_ = std::numeric_limits<double>::quiet_NaN();
     if (f.has("model") == f.has("map"))
       f.fail("expected either fuel.model (one fuel everywhere, e.g. \"GR2\") or fuel.map (a raster of the fuel "
              "table's codes)");
     auto add_bed = [&](const FuelModel& m) {
-      code_index_[m.code] = int(beds_.size());
-      beds_.push_back(surface_fire(m, moisture_));
+      code_index_[m.code] = int(models_.size());
+      models_.push_back(m);
+      if (moisture_.kind() != MoistureField::Kind::constant) return;  // per time or per vertex
+      beds_.push_back(surface_fire(m, moisture_.at(0, 0, 0)));
       const SurfaceFire& bed = beds_.back();
       if (!bed.extinct.empty() && m.burnable()) spdlog::warn("{}", bed.extinct);
     };
@@ -661,6 +673,14 @@ class FireModel final : public VelocityModel {
   // wind are the vertex's, the direction of the front is applied by ellipse_normal_rate.
   void update_spreads(const SurfaceMesh& mesh, const VectorField& normals, std::span<const int> active, double time) {
     spreads_.resize(mesh.n_vertices());
+    if (moisture_.kind() == MoistureField::Kind::series && time != beds_time_) {
+      // Moistures in time: every fuel's bed at this (sub-)step's time.
+      beds_.clear();
+      const FuelMoisture now = moisture_.at(0, 0, time);
+      for (const FuelModel& m : models_) beds_.push_back(surface_fire(m, now, false));
+      beds_time_ = time;
+    }
+    const bool per_vertex = moisture_.kind() == MoistureField::Kind::maps;
     auto update = [&](int v) {
       const Vec3& x = mesh.point(VertexHandle(v));
       const int fuel = fuel_at(x[0], x[1]);
@@ -668,7 +688,9 @@ class FireModel final : public VelocityModel {
         spreads_[std::size_t(v)] = HeadSpread{};
         return;
       }
-      const SurfaceFire& bed = beds_[std::size_t(fuel)];
+      // Moisture rasters: the bed of this vertex's fuel under its own moistures.
+      const SurfaceFire bed = per_vertex ? surface_fire(models_[std::size_t(fuel)], moisture_.at(x[0], x[1], time), false)
+                                         : beds_[std::size_t(fuel)];
       spreads_[std::size_t(v)] = head_spread_on_terrain(bed, normals[v], wind_.at(x, time),
                                                         midflame_factor(wind_height_, bed.depth), spread_options_);
     };
@@ -682,6 +704,7 @@ class FireModel final : public VelocityModel {
   // from the rate each burnt at and the fuel of its centre.
   void write_intensity_grids(ModelOutputs& outputs, const std::vector<std::pair<std::string, std::string>>& items) const {
     const HeightGrid& rate = arrival_.rate_grid();
+    const HeightGrid& arrival = arrival_.grid();
     HeightGrid heat = rate, intensity = rate, flame = rate;
     for (std::size_t row = 0; row < rate.rows; ++row)
       for (std::size_t col = 0; col < rate.cols; ++col) {
@@ -693,7 +716,13 @@ class FireModel final : public VelocityModel {
         const double x = rate.x_origin + (double(col) + 0.5) * rate.cell_size;
         const double y = rate.y_origin + (double(rate.rows - row) - 0.5) * rate.cell_size;
         const int fuel = fuel_at(x, y);
-        const double h = fuel < 0 ? 0.0 : beds_[std::size_t(fuel)].heat_per_unit_area;
+        // The heat of the cell's fuel under its moistures when it burnt.
+        double h = 0;
+        if (fuel >= 0)
+          h = moisture_.kind() == MoistureField::Kind::constant
+                  ? beds_[std::size_t(fuel)].heat_per_unit_area
+                  : surface_fire(models_[std::size_t(fuel)], moisture_.at(x, y, arrival.at(row, col)), false)
+                        .heat_per_unit_area;
         heat.heights[cell] = h;
         intensity.heights[cell] = fireline_intensity(h, rate.at(row, col));
         flame.heights[cell] = flame_length(intensity.heights[cell]);
@@ -712,8 +741,10 @@ class FireModel final : public VelocityModel {
   BalbiParameters base_;
   std::vector<BalbiParameters> fuels_;
   FuelTable table_;                              ///< rothermel: the fuel models
-  FuelMoisture moisture_;                        ///< rothermel: [model.moisture]
-  std::vector<SurfaceFire> beds_;                ///< rothermel: the fuel beds under moisture_
+  MoistureField moisture_;                       ///< rothermel: [model.moisture]
+  std::vector<FuelModel> models_;                ///< rothermel: the fuels the run may meet
+  std::vector<SurfaceFire> beds_;                ///< rothermel: their beds under constant moistures, or at beds_time_
+  double beds_time_ = std::numeric_limits<double>::quiet_NaN();
   std::unordered_map<long long, int> code_index_;  ///< rothermel: fuel code → beds_ index
   SpreadOptions spread_options_;
   WindHeight wind_height_ = WindHeight::midflame;

@@ -76,19 +76,3 @@ bool moisture_scenario(std::string_view name, FuelMoisture& moisture);
 std::string moisture_percent_problem(double percent);
 
 }  // namespace bodyfit::fire
-
-namespace bodyfit {
-class Parameters;
-struct ParameterDecl;
-}  // namespace bodyfit
-
-namespace bodyfit::fire {
-
-/// The declarations of [model.moisture] (keys "moisture.<key>"): a scenario or the five classes, in %.
-std::vector<ParameterDecl> moisture_parameters();
-/// [model.moisture] read through moisture_parameters(): `scenario` ("D2L2") or every class
-/// (dead_1h, dead_10h, dead_100h, live_herb, live_woody, in percent); both, neither, a missing
-/// class or a value that is not a percentage are errors naming the key.
-FuelMoisture read_moisture(Parameters& moisture);
-
-}  // namespace bodyfit::fire

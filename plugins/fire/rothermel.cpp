@@ -77,11 +77,11 @@ double moisture_damping(double moisture, double extinction) {
 
 }  // namespace
 
-SurfaceFire surface_fire(const FuelModel& fuel, const FuelMoisture& moisture) {
+SurfaceFire surface_fire(const FuelModel& fuel, const FuelMoisture& moisture, bool explain) {
   SurfaceFire fire;
   fire.depth = fuel.depth;
   if (!fuel.burnable()) {
-    fire.extinct = fmt::format("{} carries no fire (no fuel)", fuel.name);
+    if (explain) fire.extinct = fmt::format("{} carries no fire (no fuel)", fuel.name);
     return fire;
   }
   auto load = [&](int k) { return fuel.load[k] / kPoundPerSquareFoot; };
@@ -157,7 +157,8 @@ SurfaceFire surface_fire(const FuelModel& fuel, const FuelMoisture& moisture) {
   fire.max_effective_wind = 0.9 * reaction_intensity * kFootPerMinute;
   if (!(fire.rate0 > 0)) {
     fire.rate0 = 0;
-    fire.extinct = fmt::format("{} does not burn: the dead fuel's moisture ({:.3g} %) is at or above its moisture of "
+    if (explain)
+      fire.extinct = fmt::format("{} does not burn: the dead fuel's moisture ({:.3g} %) is at or above its moisture of "
                                "extinction ({:.3g} %){}",
                                fuel.name, 100 * d.moisture, 100 * dead_extinction,
                                l.area > 0 ? fmt::format(" and the live fuel's ({:.3g} %) at or above its own ({:.3g} %)",

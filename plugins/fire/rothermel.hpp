@@ -27,8 +27,9 @@ struct SurfaceFire {
 };
 
 /// The fuel bed of `fuel` under `moisture` (dead and live moistures of extinction, the dynamic
-/// transfer of cured herbaceous load to the dead classes).
-SurfaceFire surface_fire(const FuelModel& fuel, const FuelMoisture& moisture);
+/// transfer of cured herbaceous load to the dead classes). `explain`: say in `extinct` why it does
+/// not burn (false where that is not read: per vertex, per cell).
+SurfaceFire surface_fire(const FuelModel& fuel, const FuelMoisture& moisture, bool explain = true);
 
 struct SpreadOptions {
   /// Cap the effective wind speed at 0.9 × the reaction intensity (Rothermel 1972), as BehavePlus

@@ -30,40 +30,6 @@ Vec3 wind_from_direction(double speed, double direction_deg) {
   return Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
 }
 
-/// The times of the rows: seconds after t = 0, or ISO 8601 date-times (seconds since the epoch),
-/// all of one kind, strictly increasing.
-void read_times(const Csv& csv, WindSeries& series) {
-  for (std::size_t k = 0; k < csv.rows.size(); ++k) {
-    const CsvRow& row = csv.rows[k];
-    const std::string& text = row.fields[csv.column("time")];
-    double time = 0;
-    bool clock = false;
-    if (const std::optional<double> date = parse_iso8601(text)) {
-      time = *date;
-      clock = true;
-    } else {
-      try {
-        time = finite_number(csv, row, "time");
-      } catch (const InputError&) {
-        throw file_error(csv.file, row.line,
-                         fmt::format("time: '{}' is neither a number of seconds after t = 0 nor an ISO 8601 date-time "
-                                     "with its zone (2026-07-14T13:00:00Z)",
-                                     text));
-      }
-    }
-    if (k == 0) series.clock_times = clock;
-    if (clock != series.clock_times)
-      throw file_error(csv.file, row.line,
-                       fmt::format("time: '{}' is {}, the first time is {}: give every time the same way", text,
-                                   clock ? "a date-time" : "in seconds", clock ? "in seconds" : "a date-time"));
-    if (k > 0 && !(time > series.times.back()))
-      throw file_error(csv.file, row.line,
-                       fmt::format("time {} is not after the previous row's (line {}): times must increase", text,
-                                   csv.rows[k - 1].line));
-    series.times.push_back(time);
-  }
-}
-
 bool same_frame(const HeightGrid& a, const HeightGrid& b) {
   return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
          a.cell_size == b.cell_size;
@@ -87,7 +53,7 @@ WindSeries read_wind_series(const std::filesystem::path& file) {
   if (components) require_columns(csv, {"time", "u", "v"}, expected);
   else require_columns(csv, {"time", "speed", "direction_deg"}, expected);
   WindSeries series{.file = file};
-  read_times(csv, series);
+  series.times = read_series_times(csv, series.clock_times);
   for (const CsvRow& row : csv.rows) {
     if (components) {
       series.uniform.emplace_back(finite_number(csv, row, "u"), finite_number(csv, row, "v"), 0);
@@ -105,7 +71,7 @@ WindSeries read_wind_grid_series(const std::filesystem::path& file, const Raster
   const Csv csv = read_csv(file, "the wind series", expected);
   require_columns(csv, {"time", "u_file", "v_file"}, expected);
   WindSeries series{.file = file};
-  read_times(csv, series);
+  series.times = read_series_times(csv, series.clock_times);
   for (const CsvRow& row : csv.rows) {
     for (auto [column, grids, files] : {std::tuple{"u_file", &series.u, &series.u_files},
                                         std::tuple{"v_file", &series.v, &series.v_files}}) {
@@ -143,12 +109,7 @@ TimeBracket bracket_time(const std::vector<double>& times, double t) {
 
 void WindField::set_clock(std::optional<double> clock_start) {
   if (on_clock_ || series.times.empty()) return;
-  if (series.clock_times && !clock_start)
-    throw file_error(series.file, "its times are ISO 8601 date-times: the case needs [time] start (the date-time of "
-                                  "t = 0), or give the times in seconds after t = 0");
-  run_times_ = series.times;
-  if (series.clock_times)
-    for (double& t : run_times_) t -= *clock_start;
+  run_times_ = series_run_times(series.times, series.clock_times, clock_start, series.file);
   on_clock_ = true;
 }
 
