@@ -3,6 +3,7 @@
 // ellipse, Byram's intensity and flame length): the fire model's own physics, one point at a time.
 #include "commands.hpp"
 
+#include "crown.hpp"
 #include "fuel.hpp"
 #include "rothermel.hpp"
 
@@ -26,6 +27,8 @@ struct RosArguments {
   std::string model = "rothermel", fuel, table, table_file, scenario;
   std::optional<double> moisture[kFuelClasses];
   double wind = 0, slope = 0, wind_direction = 0;
+  std::optional<double> canopy_base_height, canopy_bulk_density;
+  double foliar_moisture = 100;
   std::string wind_unit = "m/s", wind_height = "midflame";
   bool json = false, no_wind_limit = false;
 };
@@ -90,6 +93,28 @@ int ros_command(const RosArguments& args) {
   const HeadSpread s = head_spread(fire, Vec3(midflame * std::cos(angle), midflame * std::sin(angle), 0),
                                    Vec3(1, 0, 0), std::tan(args.slope * M_PI / 180),
                                    {.limit_effective_wind = !args.no_wind_limit});
+  // A canopy: the crown fire over the surface fire (the 20-ft wind: a midflame one goes back up).
+  const bool canopy_given = args.canopy_base_height || args.canopy_bulk_density;
+  if (canopy_given && !(args.canopy_base_height && args.canopy_bulk_density))
+    throw InputError("--cbh and --cbd: a canopy needs both its base height and its bulk density");
+  CrownFire crown;
+  crown.spread = s;
+  if (canopy_given) {
+    const double waf = wind_adjustment_factor(fuel->depth);
+    const double to_20ft = height == WindHeight::twenty_feet ? 1.0
+                           : height == WindHeight::ten_metres ? 1 / 1.15
+                           : waf > 0                         ? 1 / waf
+                                                             : 0.0;
+    const double wind_20ft = args.wind * wind_units().at(args.wind_unit) * to_20ft;
+    const SurfaceFire fm10 = surface_fire(*fuel_table("anderson13").find("FM10"), moisture);
+    const std::string problem = moisture_percent_problem(args.foliar_moisture);
+    if (!problem.empty()) throw InputError("--fmc: " + problem);
+    crown = crown_fire(s, fire.heat_per_unit_area,
+                       {.base_height = *args.canopy_base_height, .bulk_density = *args.canopy_bulk_density,
+                        .foliar_moisture = args.foliar_moisture / 100},
+                       fm10, Vec3(wind_20ft * std::cos(angle), wind_20ft * std::sin(angle), 0), Vec3(1, 0, 0),
+                       std::tan(args.slope * M_PI / 180), {.limit_effective_wind = !args.no_wind_limit});
+  }
   const double intensity = fireline_intensity(fire.heat_per_unit_area, s.head);
   const double flame = flame_length(intensity);
   const double direction = s.head > 0 && s.direction.norm() > 0 ? std::atan2(s.direction[1], s.direction[0]) * 180 / M_PI : 0;
@@ -98,10 +123,16 @@ int ros_command(const RosArguments& args) {
                "\"midflame_wind_mps\": {:.9g}, \"effective_wind_mps\": {:.9g}, \"wind_limited\": {}, "
                "\"length_to_width\": {:.9g}, \"direction_of_max_spread_deg\": {:.9g}, "
                "\"reaction_intensity_kw_per_m2\": {:.9g}, \"heat_per_unit_area_kj_per_m2\": {:.9g}, "
-               "\"fireline_intensity_kw_per_m\": {:.9g}, \"flame_length_m\": {:.9g}, \"extinct\": \"{}\"}}\n",
+               "\"fireline_intensity_kw_per_m\": {:.9g}, \"flame_length_m\": {:.9g}, \"extinct\": \"{}\"{}}}\n",
                fuel->name, s.head, s.flank, s.back, midflame, s.effective_wind, s.wind_limited ? "true" : "false",
                s.length_to_width, direction, fire.reaction_intensity, fire.heat_per_unit_area, intensity, flame,
-               fire.extinct);
+               fire.extinct,
+               canopy_given ? fmt::format(", \"fire_type\": \"{}\", \"crown_initiation_intensity_kw_per_m\": {:.9g}, "
+                                          "\"crown_active_ros_mps\": {:.9g}, \"crown_critical_ros_mps\": {:.9g}, "
+                                          "\"final_ros_head_mps\": {:.9g}",
+                                          fire_type_name(crown.type), crown.initiation_intensity, crown.active_rate,
+                                          crown.critical_active_rate, crown.spread.head)
+                            : std::string());
     return 0;
   }
   const double ft_min = 60 / 0.3048;
@@ -119,6 +150,12 @@ int ros_command(const RosArguments& args) {
   fmt::print("heat per unit area    {:9.0f} kJ/m²\n", fire.heat_per_unit_area);
   fmt::print("fireline intensity    {:9.1f} kW/m\n", intensity);
   fmt::print("flame length          {:9.2f} m\n", flame);
+  if (canopy_given) {
+    fmt::print("fire type             {}\n", fire_type_name(crown.type));
+    fmt::print("crown initiation      {:9.1f} kW/m (surface head intensity {:.1f})\n", crown.initiation_intensity, intensity);
+    fmt::print("crown rate, active    {:9.4f} m/s (critical {:.4f} m/s)\n", crown.active_rate, crown.critical_active_rate);
+    fmt::print("final head rate       {:9.4f} m/s  {:9.2f} ft/min\n", crown.spread.head, crown.spread.head * ft_min);
+  }
   return 0;
 }
 
@@ -145,6 +182,13 @@ bodyfit::cli::Command setup_ros(CLI::App& app) {
   cmd->add_option("--wind-direction", args->wind_direction, "direction the wind blows to, degrees from upslope")
       ->capture_default_str();
   cmd->add_option("--slope", args->slope, "slope, degrees")->capture_default_str();
+  cmd->add_option_function<double>("--cbh", [args](double v) { args->canopy_base_height = v; },
+                                   "canopy base height, m (with --cbd: crown fire)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option_function<double>("--cbd", [args](double v) { args->canopy_bulk_density = v; },
+                                   "canopy bulk density, kg/m³")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--fmc", args->foliar_moisture, "foliar moisture content, percent")->capture_default_str();
   cmd->add_flag("--no-wind-limit", args->no_wind_limit, "do not cap the effective wind (Rothermel's limit)");
   cmd->add_flag("--json", args->json, "one JSON object instead of the table");
   return {cmd, [args]() { return ros_command(*args); }};

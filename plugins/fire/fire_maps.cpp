@@ -93,6 +93,7 @@ void ArrivalRaster::initialise(const SurfaceMesh& mesh, double cell_size, const 
   grid_.nodata = -9999;
   grid_.heights.assign(grid_.cols * grid_.rows, std::numeric_limits<double>::quiet_NaN());
   rate_ = grid_;
+  recorded_.assign(recorded_names_.size(), grid_);
 }
 
 void ArrivalRaster::save(ModelState& state) const {
@@ -101,6 +102,7 @@ void ArrivalRaster::save(ModelState& state) const {
   state.set("arrival.frame", std::vector<double>{grid_.x_origin, grid_.y_origin, grid_.cell_size, grid_.nodata});
   state.set("arrival.times", grid_.heights);
   state.set("arrival.rates", rate_.heights);
+  for (std::size_t k = 0; k < recorded_.size(); ++k) state.set("arrival.recorded." + recorded_names_[k], recorded_[k].heights);
 }
 
 void ArrivalRaster::load(const ModelState& state) {
@@ -122,24 +124,38 @@ void ArrivalRaster::load(const ModelState& state) {
     rate_.heights = state.numbers("arrival.rates");
   else
     rate_.heights.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
+  recorded_.assign(recorded_names_.size(), rate_);
+  for (std::size_t k = 0; k < recorded_.size(); ++k) {
+    const std::string key = "arrival.recorded." + recorded_names_[k];
+    if (state.has(key) && state.numbers(key).size() == times.size()) recorded_[k].heights = state.numbers(key);
+    else recorded_[k].heights.assign(times.size(), std::numeric_limits<double>::quiet_NaN());
+  }
   swept_ = true;  // the state comes from a run past its first update
 }
 
 void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next,
-                           double time, double dt, std::span<const int> changed, const ScalarField* speed) {
+                           double time, double dt, std::span<const int> changed, const ScalarField* speed,
+                           std::span<const ScalarField* const> recorded) {
   auto reach = [&](double& arrival, FaceHandle f, const std::array<double, 3>& bary) {
     auto vs = face_vertices(mesh, f);
-    double d = 0, phi = 0, rate = 0;
+    double d = 0, phi = 0;
     for (int k = 0; k < 3; ++k) {
       d += bary[k] * distance[vs[k].idx()];
       phi += bary[k] * phi_next[vs[k].idx()];
-      if (speed) rate += bary[k] * (*speed)[vs[k].idx()];
     }
+    auto at_crossing = [&](const ScalarField& field) {
+      double value = 0;
+      for (int k = 0; k < 3; ++k) value += bary[k] * field[vs[k].idx()];
+      return value;
+    };
     if (d <= 0) {
       arrival = time;  // already burnt at t^n (the initial region)
     } else if (phi <= 0) {
       arrival = time + dt * std::clamp(d / (d - phi), 0.0, 1.0);
-      if (speed) rate_.heights[std::size_t(&arrival - grid_.heights.data())] = rate;
+      const std::size_t cell = std::size_t(&arrival - grid_.heights.data());
+      if (speed) rate_.heights[cell] = at_crossing(*speed);
+      for (std::size_t k = 0; k < recorded.size() && k < recorded_.size(); ++k)
+        if (recorded[k]) recorded_[k].heights[cell] = at_crossing(*recorded[k]);
     }
   };
   if (!swept_ || changed.empty()) {

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
-#include <vector>
 #include <string>
+#include <vector>
 
 namespace bodyfit::fire {
 
@@ -30,8 +30,14 @@ class ArrivalRaster {
   /// (all when empty). After the first update, which sweeps every cell (the initial region), only
   /// the cells under the faces around `changed` can be reached, and only those are visited.
   /// `speed`: the rate of spread at the vertices of `mesh` in this step (null: not recorded).
+  /// `recorded`: more fields at the vertices, recorded like the rate (the names set by record()).
   void update(const SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next, double time, double dt,
-              std::span<const int> changed = {}, const ScalarField* speed = nullptr);
+              std::span<const int> changed = {}, const ScalarField* speed = nullptr,
+              std::span<const ScalarField* const> recorded = {});
+  /// The fields recorded besides the rate as the front crosses each cell (before initialise()).
+  void record(std::vector<std::string> names) { recorded_names_ = std::move(names); }
+  /// A recorded field on the raster's cells (NaN: not reached, or burning at the start).
+  const HeightGrid& recorded(std::size_t k) const { return recorded_[k]; }
   /// Arrival time at the vertices (bilinear over reached cells; NaN where none is reached yet).
   ScalarField sample_at_vertices(const SurfaceMesh& mesh) const;
   /// Arrival times (s; NaN: not reached) and rates of spread (m/s; NaN: none) on the same raster.
@@ -45,6 +51,8 @@ class ArrivalRaster {
  private:
   HeightGrid grid_;  ///< heights hold the arrival times (NaN = not reached)
   HeightGrid rate_;  ///< the same frame; heights hold the rates of spread
+  std::vector<std::string> recorded_names_;
+  std::vector<HeightGrid> recorded_;  ///< the same frame, one per recorded_names_
   bool swept_ = false;  ///< every cell visited once (the initial region is in the raster)
   std::vector<std::uint32_t> face_seen_;  ///< = epoch_ for the faces visited by this update
   std::uint32_t epoch_ = 0;

@@ -3,6 +3,7 @@
 // wind and the orientation of the front (extended conormal n_Σ of the context).
 #include "balbi.hpp"
 #include "barriers.hpp"
+#include "crown.hpp"
 #include "fire_maps.hpp"
 #include "fuel.hpp"
 #include "moisture.hpp"
@@ -182,6 +183,16 @@ class FireModel final : public VelocityModel {
             .fallback(0.0)
             .at_least(0),
     };
+    declared.push_back(ParameterDecl::number("canopy.base_height", "m", "rothermel: canopy base height (crown fire)")
+                           .at_least(0));
+    declared.push_back(ParameterDecl::path("canopy.base_height_map", "rothermel: canopy base height per cell, m"));
+    declared.push_back(ParameterDecl::number("canopy.bulk_density", "kg/m³", "rothermel: canopy bulk density (crown "
+                                                                            "fire; 0: no canopy)")
+                           .at_least(0));
+    declared.push_back(ParameterDecl::path("canopy.bulk_density_map", "rothermel: canopy bulk density per cell, kg/m³"));
+    declared.push_back(ParameterDecl::number("canopy.foliar_moisture", "%", "rothermel: foliar moisture content")
+                           .fallback(100.0)
+                           .positive());
     declared.push_back(ParameterDecl::boolean("limit_effective_wind", "rothermel: cap the effective wind at 0.9 × the "
                                                                      "reaction intensity (Rothermel 1972), as BehavePlus")
                            .fallback(true));
@@ -211,6 +222,8 @@ class FireModel final : public VelocityModel {
                          "rothermel: Byram's fireline intensity at which each cell burnt (heat per unit area × rate)"),
         OutputDecl::grid("flame_length", "m", "rothermel: Byram's flame length at which each cell burnt"),
         OutputDecl::grid("heat_per_unit_area", "kJ/m²", "rothermel: the heat each burnt cell released per unit area"),
+        OutputDecl::grid("fire_type", "1", "rothermel with [model.canopy]: 1 surface, 2 passive crown, 3 active "
+                                           "crown fire, where each cell burnt"),
         OutputDecl::value("burnt_area", "m²", "|G| at the end: the area burnt, on the surface"),
         OutputDecl::file("perimeters.gpkg", "the burnt region's outline (perimeters.file)"),
         OutputDecl::file("perimeters.geojson", "the same as GeoJSON (perimeters.file)"),
@@ -222,6 +235,8 @@ class FireModel final : public VelocityModel {
 
   void configure(Parameters& p) override {
     rothermel_ = p.choice("spread") == "rothermel";
+    has_canopy_ = false;
+    arrival_.record({});
     huygens_ = p.choice("front_velocity") == "huygens";
     surface_slope_ = p.choice("slope") == "surface";
 
@@ -283,8 +298,11 @@ class FireModel final : public VelocityModel {
     if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
     for (const auto& raster : wind_.rasters()) rasters.push_back(raster);
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
-    if (rothermel_)
+    if (rothermel_) {
       for (const auto& raster : moisture_.rasters()) rasters.push_back(raster);
+      if (canopy_height_map_.cols > 0) rasters.emplace_back(&canopy_height_map_, canopy_height_file_);
+      if (canopy_density_map_.cols > 0) rasters.emplace_back(&canopy_density_map_, canopy_density_file_);
+    }
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
     std::filesystem::path first_file;
@@ -425,9 +443,16 @@ class FireModel final : public VelocityModel {
   void end_step(const StepOutcome& outcome) override {
     // dt = 0: a region joined G (a late ignition) on the accepted state, whose rates are not
     // rates_ (those of the state before): its cells arrive at that time with no rate of spread.
-    if (arrival_.initialised())
+    if (arrival_.initialised()) {
+      const bool current = outcome.dt > 0 && rates_.size() == outcome.mesh.n_vertices();
+      const std::size_t n = outcome.mesh.n_vertices();
+      const ScalarField* recorded[] = {current && heats_.size() == n ? &heats_ : nullptr,
+                                       current && types_.size() == n ? &types_ : nullptr};
       arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt, outcome.changed,
-                      outcome.dt > 0 && rates_.size() == outcome.mesh.n_vertices() ? &rates_ : nullptr);
+                      current ? &rates_ : nullptr,
+                      rothermel_ ? std::span<const ScalarField* const>(recorded, has_canopy_ ? 2 : 1)
+                                 : std::span<const ScalarField* const>());
+    }
   }
 
   // What a resumed run needs to continue exactly: the arrival times so far and the rotating wind's
@@ -492,7 +517,8 @@ class FireModel final : public VelocityModel {
  private:
   // Balbi's parameters: the preset's, or per fuel class of the fuel map; Rothermel's keys refused.
   void configure_balbi(Parameters& p) {
-    p.forbid({"moisture", "limit_effective_wind"}, "to spread = \"balbi\" (Rothermel's: set spread = \"rothermel\")");
+    p.forbid({"moisture", "limit_effective_wind", "canopy"},
+             "to spread = \"balbi\" (Rothermel's: set spread = \"rothermel\")");
     const std::string preset_name = p.choice("preset");
     base_ = preset(preset_name);
     base_.u0 = p.number("u0");
@@ -555,6 +581,12 @@ class FireModel final : public VelocityModel {
       const SurfaceFire& bed = beds_.back();
       if (!bed.extinct.empty() && m.burnable()) spdlog::warn("{}", bed.extinct);
     };
+    configure_canopy(p);
+    fm10_ = *fuel_table("anderson13").find("FM10");
+    if (moisture_.kind() == MoistureField::Kind::constant) fm10_bed_ = surface_fire(fm10_, moisture_.at(0, 0, 0));
+    std::vector<std::string> recorded = {"heat_per_unit_area"};
+    if (has_canopy_) recorded.push_back("fire_type");
+    arrival_.record(recorded);
     if (f.has("model")) {
       const std::string name = f.string("model");
       const FuelModel* m = table_.find(name);
@@ -563,6 +595,40 @@ class FireModel final : public VelocityModel {
     } else {
       for (const FuelModel& m : table_.models) add_bed(m);
     }
+  }
+
+  // [model.canopy]: the canopy base height and bulk density (numbers or rasters) and the foliar
+  // moisture, for crown fire; no table, no crown fire.
+  void configure_canopy(Parameters& p) {
+    has_canopy_ = p.has("canopy");
+    canopy_height_map_ = HeightGrid();
+    canopy_density_map_ = HeightGrid();
+    if (!has_canopy_) return;
+    Parameters& c = p.section("canopy");
+    auto read_quantity = [&](const char* key, double& value, HeightGrid& map, std::filesystem::path& file) {
+      const std::string map_key = std::string(key) + "_map";
+      if (c.has(map_key)) {
+        if (c.has(key)) c.fail(map_key, fmt::format("give either {} or {}, not both", key, map_key));
+        file = c.path(map_key);
+        map = read_model_raster(file, Resampling::bilinear);
+        fill_nodata(map);
+      } else {
+        value = c.required_number(key);
+      }
+    };
+    read_quantity("base_height", canopy_.base_height, canopy_height_map_, canopy_height_file_);
+    read_quantity("bulk_density", canopy_.bulk_density, canopy_density_map_, canopy_density_file_);
+    const double foliar = c.number("foliar_moisture");
+    const std::string problem = moisture_percent_problem(foliar);
+    if (!problem.empty()) c.fail("foliar_moisture", problem);
+    canopy_.foliar_moisture = foliar / 100;
+  }
+
+  Canopy canopy_at(double x, double y) const {
+    Canopy canopy = canopy_;
+    if (canopy_height_map_.cols > 0) canopy.base_height = std::max(0.0, canopy_height_map_.sample(x, y));
+    if (canopy_density_map_.cols > 0) canopy.bulk_density = std::max(0.0, canopy_density_map_.sample(x, y));
+    return canopy;
   }
 
   // The state's outline, once per iteration (sub-steps and retried steps compute on the same
@@ -672,65 +738,82 @@ class FireModel final : public VelocityModel {
   // Rothermel's fire ellipse at the vertices R is needed at (the band's, or all): fuel, slope and
   // wind are the vertex's, the direction of the front is applied by ellipse_normal_rate.
   void update_spreads(const SurfaceMesh& mesh, const VectorField& normals, std::span<const int> active, double time) {
-    spreads_.resize(mesh.n_vertices());
+    const std::size_t n = mesh.n_vertices();
+    spreads_.resize(n);
+    heats_.resize(n, 0.0);
+    if (has_canopy_) types_.resize(n, double(FireType::surface));
     if (moisture_.kind() == MoistureField::Kind::series && time != beds_time_) {
       // Moistures in time: every fuel's bed at this (sub-)step's time.
       beds_.clear();
       const FuelMoisture now = moisture_.at(0, 0, time);
       for (const FuelModel& m : models_) beds_.push_back(surface_fire(m, now, false));
+      fm10_bed_ = surface_fire(fm10_, now, false);
       beds_time_ = time;
     }
     const bool per_vertex = moisture_.kind() == MoistureField::Kind::maps;
     auto update = [&](int v) {
+      const std::size_t i = std::size_t(v);
       const Vec3& x = mesh.point(VertexHandle(v));
       const int fuel = fuel_at(x[0], x[1]);
       if (fuel < 0) {
-        spreads_[std::size_t(v)] = HeadSpread{};
+        spreads_[i] = HeadSpread{};
+        heats_[i] = 0;
+        if (has_canopy_) types_[i] = double(FireType::surface);
         return;
       }
       // Moisture rasters: the bed of this vertex's fuel under its own moistures.
-      const SurfaceFire bed = per_vertex ? surface_fire(models_[std::size_t(fuel)], moisture_.at(x[0], x[1], time), false)
+      const FuelMoisture moisture = per_vertex ? moisture_.at(x[0], x[1], time) : FuelMoisture{};
+      const SurfaceFire bed = per_vertex ? surface_fire(models_[std::size_t(fuel)], moisture, false)
                                          : beds_[std::size_t(fuel)];
-      spreads_[std::size_t(v)] = head_spread_on_terrain(bed, normals[v], wind_.at(x, time),
-                                                        midflame_factor(wind_height_, bed.depth), spread_options_);
+      const Vec3 wind = wind_.at(x, time);
+      spreads_[i] = head_spread_on_terrain(bed, normals[v], wind, midflame_factor(wind_height_, bed.depth), spread_options_);
+      heats_[i] = bed.heat_per_unit_area;
+      if (!has_canopy_) return;
+      // The crown fire over it: the 20-ft wind (a midflame wind goes back up by the bed's factor).
+      const double waf = wind_adjustment_factor(bed.depth);
+      const double to_20ft = wind_height_ == WindHeight::twenty_feet ? 1.0
+                             : wind_height_ == WindHeight::ten_metres ? 1 / 1.15
+                             : waf > 0                                ? 1 / waf
+                                                                      : 0.0;
+      const TerrainSlope slope = terrain_slope(normals[v]);
+      const CrownFire crown =
+          crown_fire(spreads_[i], bed.heat_per_unit_area, canopy_at(x[0], x[1]),
+                     per_vertex ? surface_fire(fm10_, moisture, false) : fm10_bed_,
+                     tangent_wind(to_20ft * wind, normals[v]), slope.upslope, slope.tan_slope, spread_options_);
+      spreads_[i] = crown.spread;
+      types_[i] = double(crown.type);
     };
     if (!active.empty())
       for (int v : active) update(v);
     else
-      for (int v = 0; v < int(mesh.n_vertices()); ++v) update(v);
+      for (int v = 0; v < int(n); ++v) update(v);
   }
 
-  // Byram's fireline intensity, flame length and the heat per unit area of the cells that burnt,
-  // from the rate each burnt at and the fuel of its centre.
+  // Byram's fireline intensity, flame length and the heat per unit area of the cells that burnt
+  // (the heat recorded as the front crossed each, times the rate it crossed at), and with a canopy
+  // the fire type there.
   void write_intensity_grids(ModelOutputs& outputs, const std::vector<std::pair<std::string, std::string>>& items) const {
     const HeightGrid& rate = arrival_.rate_grid();
-    const HeightGrid& arrival = arrival_.grid();
-    HeightGrid heat = rate, intensity = rate, flame = rate;
-    for (std::size_t row = 0; row < rate.rows; ++row)
-      for (std::size_t col = 0; col < rate.cols; ++col) {
-        const std::size_t cell = row * rate.cols + col;
-        if (!rate.valid(row, col)) {
-          heat.heights[cell] = intensity.heights[cell] = flame.heights[cell] = rate.nodata;
-          continue;
-        }
-        const double x = rate.x_origin + (double(col) + 0.5) * rate.cell_size;
-        const double y = rate.y_origin + (double(rate.rows - row) - 0.5) * rate.cell_size;
-        const int fuel = fuel_at(x, y);
-        // The heat of the cell's fuel under its moistures when it burnt.
-        double h = 0;
-        if (fuel >= 0)
-          h = moisture_.kind() == MoistureField::Kind::constant
-                  ? beds_[std::size_t(fuel)].heat_per_unit_area
-                  : surface_fire(models_[std::size_t(fuel)], moisture_.at(x, y, arrival.at(row, col)), false)
-                        .heat_per_unit_area;
-        heat.heights[cell] = h;
-        intensity.heights[cell] = fireline_intensity(h, rate.at(row, col));
-        flame.heights[cell] = flame_length(intensity.heights[cell]);
+    const HeightGrid& heat = arrival_.recorded(0);
+    HeightGrid intensity = rate, flame = rate, type = rate;
+    for (std::size_t cell = 0; cell < rate.heights.size(); ++cell) {
+      const double r = rate.heights[cell], h = heat.heights[cell];
+      const bool burnt = std::isfinite(r) && std::isfinite(h);
+      intensity.heights[cell] = burnt ? fireline_intensity(h, r) : std::numeric_limits<double>::quiet_NaN();
+      flame.heights[cell] = burnt ? flame_length(intensity.heights[cell]) : std::numeric_limits<double>::quiet_NaN();
+      if (has_canopy_) {
+        const double t = arrival_.recorded(1).heights[cell];
+        type.heights[cell] = burnt && std::isfinite(t) ? std::round(t) : std::numeric_limits<double>::quiet_NaN();
       }
+    }
     outputs.grid("heat_per_unit_area", grid_field(heat, "heat per unit area released, kJ/m² (Rothermel)", items, crs_));
     outputs.grid("fireline_intensity",
                  grid_field(intensity, "Byram's fireline intensity at which the cell burnt, kW/m", items, crs_));
     outputs.grid("flame_length", grid_field(flame, "Byram's flame length at which the cell burnt, m", items, crs_));
+    if (has_canopy_)
+      outputs.grid("fire_type", grid_field(type, "fire type where the cell burnt: 1 surface, 2 passive crown, 3 active "
+                                                 "crown (Van Wagner 1977, Rothermel 1991)",
+                                           items, crs_));
   }
 
   SurfaceSource surface_;  ///< what S was built from (set_surface): its CRS is the case's
@@ -749,6 +832,14 @@ class FireModel final : public VelocityModel {
   SpreadOptions spread_options_;
   WindHeight wind_height_ = WindHeight::midflame;
   std::vector<HeadSpread> spreads_;              ///< rothermel: the ellipse at the vertices (update_spreads)
+  ScalarField heats_;                            ///< rothermel: heat per unit area at the vertices, kJ/m²
+  ScalarField types_;                            ///< rothermel with a canopy: FireType at the vertices
+  bool has_canopy_ = false;                      ///< [model.canopy]: crown fire
+  Canopy canopy_;                                ///< its constant values
+  HeightGrid canopy_height_map_, canopy_density_map_;
+  std::filesystem::path canopy_height_file_, canopy_density_file_;
+  FuelModel fm10_;                               ///< Anderson's model 10 (Rothermel's 1991 crown rate)
+  SurfaceFire fm10_bed_;                         ///< under the constant moistures, or at beds_time_
   std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA
   HeightGrid fuel_map_;
   WindField wind_;

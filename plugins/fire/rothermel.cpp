@@ -253,25 +253,26 @@ double midflame_factor(WindHeight height, double depth) {
 
 namespace bodyfit::fire {
 
-HeadSpread head_spread_on_terrain(const SurfaceFire& fire, const Vec3& normal, const Vec3& wind, double to_midflame,
-                                  const SpreadOptions& options) {
+TerrainSlope terrain_slope(const Vec3& normal) {
   // Upslope: the vertical's tangential part; |e3 − (e3·N)N| = sin θ, tan θ = sin θ / |N·e3|.
   const double nz = normal[2];
   Vec3 upslope = Vec3(0, 0, 1) - nz * normal;
   const double sine = upslope.norm();
-  double tan_slope = 0;
-  if (sine > 1e-12 && std::abs(nz) > 1e-12) {
-    upslope /= sine;
-    tan_slope = sine / std::abs(nz);
-  } else {
-    upslope = Vec3(0, 0, 0);
-  }
-  Vec3 midflame = to_midflame * wind;
-  const double speed = midflame.norm();
-  Vec3 along = midflame - OpenMesh::dot(midflame, normal) * normal;
+  if (!(sine > 1e-12) || !(std::abs(nz) > 1e-12)) return {};
+  return {upslope / sine, sine / std::abs(nz)};
+}
+
+Vec3 tangent_wind(const Vec3& wind, const Vec3& normal) {
+  const double speed = wind.norm();
+  const Vec3 along = wind - OpenMesh::dot(wind, normal) * normal;
   const double length = along.norm();
-  midflame = length > 1e-12 * std::max(1.0, speed) ? along * (speed / length) : Vec3(0, 0, 0);
-  return head_spread(fire, midflame, upslope, tan_slope, options);
+  return length > 1e-12 * std::max(1.0, speed) ? along * (speed / length) : Vec3(0, 0, 0);
+}
+
+HeadSpread head_spread_on_terrain(const SurfaceFire& fire, const Vec3& normal, const Vec3& wind, double to_midflame,
+                                  const SpreadOptions& options) {
+  const TerrainSlope slope = terrain_slope(normal);
+  return head_spread(fire, tangent_wind(to_midflame * wind, normal), slope.upslope, slope.tan_slope, options);
 }
 
 }  // namespace bodyfit::fire

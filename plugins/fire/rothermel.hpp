@@ -86,6 +86,16 @@ double midflame_factor(WindHeight height, double depth);
 
 namespace bodyfit::fire {
 
+/// The slope of a terrain of unit normal `normal`: the upslope direction in its tangent plane
+/// (0 on flat ground) and tan(slope angle).
+struct TerrainSlope {
+  Vec3 upslope{0, 0, 0};
+  double tan_slope = 0;
+};
+TerrainSlope terrain_slope(const Vec3& normal);
+/// A horizontal wind turned into the tangent plane of `normal`, its speed kept.
+Vec3 tangent_wind(const Vec3& wind, const Vec3& normal);
+
 /// Rothermel's spread at a point of a terrain of unit normal `normal`: the slope and its upslope
 /// direction from the normal, the horizontal wind `wind` (m/s, at its height) times
 /// `to_midflame`, turned into the tangent plane with its speed kept.
