@@ -5,6 +5,7 @@
 #include "fuel.hpp"
 #include "rothermel.hpp"
 
+#include <bodyfit/app/dem.hpp>
 #include <bodyfit/io.hpp>
 
 #include "test_support.hpp"
@@ -115,4 +116,73 @@ vtu_every = 0
   // Every burnt cell of the crown run burnt as an active crown fire (NODATA where burning at t = 0).
   CHECK(fs::exists(dir / "crown" / "fire_type.tif"));
   CHECK_FALSE(fs::exists(dir / "surface" / "fire_type.tif"));
+}
+
+TEST_CASE("sheltered wind adjustment: Albini & Baughman's factor under a canopy, unsheltered below 5 % fill") {
+  // 50 % cover, 60 ft canopy, crown ratio 0.5: fill 0.5/3 · 0.5; 0.555 / (√(f H) ln((20 + 0.36 H)/(0.13 H))).
+  const double f = 0.5 / 3 * 0.5, h = 60.0;
+  const Sheltering shelter{.cover = 0.5, .canopy_height = 60 * 0.3048, .crown_ratio = 0.5};
+  CHECK(wind_adjustment_factor(0.3048, shelter) ==
+        doctest::Approx(0.555 / (std::sqrt(f * h) * std::log((20 + 0.36 * h) / (0.13 * h)))));
+  // A thin canopy (fill 4 %): the bed's own, unsheltered factor.
+  CHECK(wind_adjustment_factor(0.3048, {.cover = 0.24, .canopy_height = 18, .crown_ratio = 0.5}) ==
+        wind_adjustment_factor(0.3048));
+}
+
+TEST_CASE("a FARSITE landscape (.lcp): its bands in SI units, and a run on its elevation, fuel and canopy") {
+  const fs::path lcp = test::source_path("meshes/fixtures/landscape_20x20.lcp");
+  // meshes/fixtures/README.md: canopy heights stored in m × 10, bulk density in kg/m³ × 100.
+  const HeightGrid cbh = read_landscape_band(lcp, LandscapeBand::canopy_base_height);
+  const HeightGrid cbd = read_landscape_band(lcp, LandscapeBand::canopy_bulk_density);
+  const HeightGrid height = read_landscape_band(lcp, LandscapeBand::canopy_height);
+  const HeightGrid cover = read_landscape_band(lcp, LandscapeBand::canopy_cover);
+  const HeightGrid fuel = read_landscape_band(lcp, LandscapeBand::fuel);
+  const HeightGrid elevation = read_dem(lcp);
+  REQUIRE(cbh.cols == 20);
+  CHECK(cbh.at(5, 5) == doctest::Approx(2.0));
+  CHECK(cbd.at(5, 5) == doctest::Approx(0.2));
+  CHECK(height.at(5, 5) == doctest::Approx(20.0));
+  CHECK(cover.at(5, 5) == 60);
+  CHECK(fuel.at(5, 0) == 102);
+  CHECK(fuel.at(5, 19) == 165);
+  CHECK(elevation.at(0, 1) - elevation.at(0, 0) == 3);
+  CHECK(elevation.crs.find("UTM zone 32N") != std::string::npos);
+
+  // A run: the landscape's elevation as the surface, its fuel band and canopy bands as the model's.
+  test::TempDir dir("fire_landscape");
+  std::ofstream(dir / "case.toml") << fmt::format(R"([surface]
+generator = "terrain"
+dem = "{0}"
+h = 30.0
+[region]
+shape = "disks"
+centers = [[500200.0, 5500300.0]]
+radii = [60.0]
+[model]
+name = "fire"
+spread = "rothermel"
+landscape = "{0}"
+[model.moisture]
+scenario = "D1L1"
+[model.wind]
+type = "uniform"
+speed = 6.7
+direction_deg = 270.0
+height = "20ft"
+[time]
+dt = 120.0
+final_time = 600.0
+[output]
+vtu_every = 0
+)",
+                                                  lcp.string());
+  const auto result = test::run_bodyfit(fmt::format("run {} -o {}", (dir / "case.toml").string(), (dir / "out").string()));
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  CHECK(fs::exists(dir / "out" / "fire_type.tif"));
+  CHECK(fs::exists(dir / "out" / "fireline_intensity.tif"));
+  // Both the fuel map and the landscape: refused.
+  std::ofstream(dir / "both.toml") << test::read_file(dir / "case.toml") << "[model.fuel]\nmodel = \"GR2\"\n";
+  const auto both = test::run_bodyfit(fmt::format("run {} -o {}", (dir / "both.toml").string(), (dir / "out2").string()));
+  CHECK(both.exit_code == 1);
+  CHECK(both.output.find("the fuel comes from [model] landscape") != std::string::npos);
 }

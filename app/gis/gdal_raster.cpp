@@ -19,7 +19,8 @@
 namespace bodyfit::gis {
 namespace {
 
-bool read_raster(const std::filesystem::path& file, HeightGrid& grid, std::string& error) {
+bool read_raster_band(const std::filesystem::path& file, int band_number, HeightGrid& grid, std::string& unit,
+                      std::string& error) {
   GDALAllRegister();
   CPLPushErrorHandler(CPLQuietErrorHandler);
   GDALDatasetH dataset = GDALOpen(file.string().c_str(), GA_ReadOnly);
@@ -37,6 +38,8 @@ bool read_raster(const std::filesystem::path& file, HeightGrid& grid, std::strin
     return false;
   };
   if (GDALGetRasterCount(dataset) < 1) return fail("the raster has no band");
+  if (band_number < 1 || band_number > GDALGetRasterCount(dataset))
+    return fail(fmt::format("the raster has {} band(s), not a band {}", GDALGetRasterCount(dataset), band_number));
   double gt[6];
   if (GDALGetGeoTransform(dataset, gt) != CE_None) return fail("the raster has no georeferencing (geotransform)");
   if (gt[2] != 0 || gt[4] != 0) return fail("rotated rasters are not supported");
@@ -48,20 +51,35 @@ bool read_raster(const std::filesystem::path& file, HeightGrid& grid, std::strin
   grid.cell_size = gt[1];
   grid.x_origin = gt[0];
   grid.y_origin = gt[5] < 0 ? gt[3] + double(grid.rows) * gt[5] : gt[3];
-  GDALRasterBandH band = GDALGetRasterBand(dataset, 1);
+  GDALRasterBandH band = GDALGetRasterBand(dataset, band_number);
+  // The unit: a FARSITE landscape names it in "<BAND>_UNIT_NAME" metadata, others in the unit type.
+  unit.clear();
+  if (char** items = GDALGetMetadata(band, nullptr))
+    for (int i = 0; items[i]; ++i) {
+      const std::string item = items[i];
+      const std::size_t equals = item.find('=');
+      if (equals != std::string::npos && item.substr(0, equals).ends_with("_UNIT_NAME")) unit = item.substr(equals + 1);
+    }
+  if (unit.empty())
+    if (const char* type = GDALGetRasterUnitType(band)) unit = type;
   int has_nodata = 0;
   const double nodata = GDALGetRasterNoDataValue(band, &has_nodata);
   if (has_nodata) grid.nodata = nodata;
   grid.heights.resize(grid.rows * grid.cols);
   if (GDALRasterIO(band, GF_Read, 0, 0, int(grid.cols), int(grid.rows), grid.heights.data(), int(grid.cols),
                    int(grid.rows), GDT_Float64, 0, 0) != CE_None)
-    return fail(fmt::format("cannot read band 1 (GDAL: {})", CPLGetLastErrorMsg()));
+    return fail(fmt::format("cannot read band {} (GDAL: {})", band_number, CPLGetLastErrorMsg()));
   if (gt[5] > 0)  // south-up raster: store north first like an ESRI grid
     for (std::size_t r = 0; r < grid.rows / 2; ++r)
       std::swap_ranges(grid.heights.begin() + long(r * grid.cols), grid.heights.begin() + long((r + 1) * grid.cols),
                        grid.heights.begin() + long((grid.rows - 1 - r) * grid.cols));
   if (const char* wkt = GDALGetProjectionRef(dataset)) grid.crs = wkt;
   return true;
+}
+
+bool read_raster(const std::filesystem::path& file, HeightGrid& grid, std::string& error) {
+  std::string unit;
+  return read_raster_band(file, 1, grid, unit, error);
 }
 
 /// An OSR spatial reference, released at the end of the scope.
@@ -303,7 +321,8 @@ const Api kApi{.version = kApiVersion,
                .read_vector = read_vector,
                .write_polygons = write_polygons,
                .warp_raster = warp_raster,
-               .transform_points = transform_points};
+               .transform_points = transform_points,
+               .read_raster_band = read_raster_band};
 
 }  // namespace
 }  // namespace bodyfit::gis

@@ -224,11 +224,50 @@ HeightGrid reproject_to_utm(HeightGrid grid, const std::filesystem::path& file, 
 }
 
 /// The raster as the file holds it, with a terrain's checks.
+// A landscape's band as it is (NODATA kept), its values scaled to SI by the unit its header names.
+HeightGrid read_landscape_band_as_is(const std::filesystem::path& file, LandscapeBand band) {
+  static const std::map<std::string, double> lengths = {
+      {"Meters", 1.0}, {"Feet", 0.3048}, {"Meters x 10", 0.1}, {"Feet x 10", 0.03048}};
+  static const std::map<std::string, double> densities = {
+      {"kg/m^3", 1.0}, {"lb/ft^3", 16.018463}, {"kg/m^3 x 100", 0.01}, {"lb/ft^3 x 1000", 0.016018463}};
+  static const std::map<std::string, double> covers = {{"Percent", 1.0}};
+  const gis::Api& gis = gis::module_for(file);
+  HeightGrid grid;
+  std::string unit, error;
+  if (!gis.read_raster_band(file, int(band), grid, unit, error)) throw file_error(file, error);
+  const std::map<std::string, double>* units = nullptr;
+  switch (band) {
+    case LandscapeBand::elevation:
+    case LandscapeBand::canopy_height:
+    case LandscapeBand::canopy_base_height: units = &lengths; break;
+    case LandscapeBand::canopy_bulk_density: units = &densities; break;
+    case LandscapeBand::canopy_cover: units = &covers; break;
+    default: break;
+  }
+  if (units) {
+    const auto found = units->find(unit);
+    if (found == units->end())
+      throw file_error(file, fmt::format("band {}: unit '{}' is not one bodyfit converts (expected one of a FARSITE "
+                                         "landscape's)",
+                                         int(band), unit));
+    for (double& v : grid.heights)
+      if (!is_nodata(v, grid.nodata)) v *= found->second;
+  }
+  require_some_data(grid, file);
+  return grid;
+}
+
 HeightGrid read_dem_as_is(const std::filesystem::path& file) {
   const std::string ext = lower(file.extension().string());
   if (ext == ".asc") return read_esri_ascii(file);
   if (ext == ".tif" || ext == ".tiff") return read_geotiff(file);
-  throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  if (ext == ".lcp") {
+    HeightGrid grid = read_landscape_band_as_is(file, LandscapeBand::elevation);
+    check_heights(grid, file);
+    return grid;
+  }
+  throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid), .tif/.tiff (GeoTIFF) or .lcp (a "
+                         "FARSITE landscape)");
 }
 
 }  // namespace
@@ -364,6 +403,13 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
 
 HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options) {
   HeightGrid grid = read_dem_as_is(file);
+  if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file, options);
+  require_metres(grid, file);
+  return grid;
+}
+
+HeightGrid read_landscape_band(const std::filesystem::path& file, LandscapeBand band, const DemReadOptions& options) {
+  HeightGrid grid = read_landscape_band_as_is(file, band);
   if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file, options);
   require_metres(grid, file);
   return grid;

@@ -15,7 +15,7 @@
 
 namespace bodyfit::gis {
 
-inline constexpr std::uint32_t kApiVersion = 4;
+inline constexpr std::uint32_t kApiVersion = 5;
 
 /// What bodyfit needs to know of a coordinate system.
 struct CrsInfo {
@@ -59,6 +59,11 @@ struct Api {
   /// Points (x, y; longitude, latitude in a geographic system) from the system `from` to `to` (both
   /// WKT), in place; false with `error` set when there is no transformation or a point fails. (version 4)
   bool (*transform_points)(const std::string& from, const std::string& to, std::vector<PlanPoint>& points,
+                           std::string& error) = nullptr;
+  /// Band `band` (from 1) of a raster, as read_raster reads band 1, and the unit its metadata
+  /// declares in `unit` (a FARSITE landscape's "<BAND>_UNIT_NAME", else the band's unit type; ""
+  /// when none); false with `error` set when GDAL cannot read it or there is no such band. (version 5)
+  bool (*read_raster_band)(const std::filesystem::path& file, int band, HeightGrid& grid, std::string& unit,
                            std::string& error) = nullptr;
 };
 

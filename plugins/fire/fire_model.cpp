@@ -190,6 +190,14 @@ class FireModel final : public VelocityModel {
                                                                             "fire; 0: no canopy)")
                            .at_least(0));
     declared.push_back(ParameterDecl::path("canopy.bulk_density_map", "rothermel: canopy bulk density per cell, kg/m³"));
+    declared.push_back(ParameterDecl::number("canopy.cover", "%", "rothermel: canopy cover (with canopy.height: the "
+                                                                 "sheltered wind adjustment factor)")
+                           .within({.min = 0, .max = 100}));
+    declared.push_back(ParameterDecl::path("canopy.cover_map", "rothermel: canopy cover per cell, %"));
+    declared.push_back(ParameterDecl::number("canopy.height", "m", "rothermel: canopy (stand) height").at_least(0));
+    declared.push_back(ParameterDecl::path("canopy.height_map", "rothermel: canopy height per cell, m"));
+    declared.push_back(ParameterDecl::path("landscape", "rothermel: a FARSITE landscape (.lcp): its fuel band is the "
+                                                        "fuel map (codes of fuel.table), its canopy bands the canopy"));
     declared.push_back(ParameterDecl::number("canopy.foliar_moisture", "%", "rothermel: foliar moisture content")
                            .fallback(100.0)
                            .positive());
@@ -253,6 +261,7 @@ class FireModel final : public VelocityModel {
     }
     fuel_map_ = HeightGrid();
     fuel_file_.clear();
+    landscape_file_.clear();
     non_burnable_.clear();
     if (rothermel_) configure_rothermel(p);
     else configure_balbi(p);
@@ -268,6 +277,11 @@ class FireModel final : public VelocityModel {
         fuel_map_ = read_model_raster(fuel_file_, Resampling::nearest);
         check_fuel_codes();
       }
+    }
+    if (!landscape_file_.empty()) {  // a FARSITE landscape's fuel band (rothermel)
+      fuel_file_ = landscape_file_;
+      fuel_map_ = read_model_raster(fuel_file_, Resampling::nearest, LandscapeBand::fuel);
+      check_fuel_codes();
     }
     if (p.has("arrival")) {
       Parameters& a = p.section("arrival");
@@ -300,8 +314,8 @@ class FireModel final : public VelocityModel {
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
     if (rothermel_) {
       for (const auto& raster : moisture_.rasters()) rasters.push_back(raster);
-      if (canopy_height_map_.cols > 0) rasters.emplace_back(&canopy_height_map_, canopy_height_file_);
-      if (canopy_density_map_.cols > 0) rasters.emplace_back(&canopy_density_map_, canopy_density_file_);
+      for (const CanopyLayer* layer : {&base_height_layer_, &bulk_density_layer_, &cover_layer_, &height_layer_})
+        if (layer->map.cols > 0) rasters.emplace_back(&layer->map, layer->file);
     }
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
@@ -517,7 +531,7 @@ class FireModel final : public VelocityModel {
  private:
   // Balbi's parameters: the preset's, or per fuel class of the fuel map; Rothermel's keys refused.
   void configure_balbi(Parameters& p) {
-    p.forbid({"moisture", "limit_effective_wind", "canopy"},
+    p.forbid({"moisture", "limit_effective_wind", "canopy", "landscape"},
              "to spread = \"balbi\" (Rothermel's: set spread = \"rothermel\")");
     const std::string preset_name = p.choice("preset");
     base_ = preset(preset_name);
@@ -570,9 +584,14 @@ class FireModel final : public VelocityModel {
     models_.clear();
     code_index_.clear();
     beds_time_ = std::numeric_limits<double>::quiet_NaN();
-    if (f.has("model") == f.has("map"))
-      f.fail("expected either fuel.model (one fuel everywhere, e.g. \"GR2\") or fuel.map (a raster of the fuel "
-             "table's codes)");
+    if (p.has("landscape")) {
+      landscape_file_ = p.path("landscape");
+      if (f.has("model") || f.has("map"))
+        f.fail(f.has("model") ? "model" : "map", "the fuel comes from [model] landscape (its fuel band): give either");
+    } else if (f.has("model") == f.has("map")) {
+      f.fail("expected either fuel.model (one fuel everywhere, e.g. \"GR2\"), fuel.map (a raster of the fuel "
+             "table's codes) or [model] landscape (a FARSITE landscape)");
+    }
     auto add_bed = [&](const FuelModel& m) {
       code_index_[m.code] = int(models_.size());
       models_.push_back(m);
@@ -600,24 +619,34 @@ class FireModel final : public VelocityModel {
   // [model.canopy]: the canopy base height and bulk density (numbers or rasters) and the foliar
   // moisture, for crown fire; no table, no crown fire.
   void configure_canopy(Parameters& p) {
-    has_canopy_ = p.has("canopy");
-    canopy_height_map_ = HeightGrid();
-    canopy_density_map_ = HeightGrid();
+    canopy_ = Canopy{};
+    for (CanopyLayer* layer : {&base_height_layer_, &bulk_density_layer_, &cover_layer_, &height_layer_}) *layer = {};
+    const bool landscape = !landscape_file_.empty();
+    has_canopy_ = p.has("canopy") || landscape;
     if (!has_canopy_) return;
     Parameters& c = p.section("canopy");
-    auto read_quantity = [&](const char* key, double& value, HeightGrid& map, std::filesystem::path& file) {
+    // A quantity: a number, a raster, or a band of the landscape (in that order of precedence).
+    auto read_layer = [&](const char* key, CanopyLayer& layer, std::optional<LandscapeBand> band, bool required) {
       const std::string map_key = std::string(key) + "_map";
       if (c.has(map_key)) {
         if (c.has(key)) c.fail(map_key, fmt::format("give either {} or {}, not both", key, map_key));
-        file = c.path(map_key);
-        map = read_model_raster(file, Resampling::bilinear);
-        fill_nodata(map);
+        layer.file = c.path(map_key);
+        layer.map = read_model_raster(layer.file, Resampling::bilinear);
+      } else if (c.has(key) || (required && !landscape)) {
+        layer.value = c.required_number(key);
+        return;
+      } else if (band && landscape) {
+        layer.file = landscape_file_;
+        layer.map = read_model_raster(landscape_file_, Resampling::bilinear, band);
       } else {
-        value = c.required_number(key);
+        return;
       }
+      fill_nodata(layer.map);
     };
-    read_quantity("base_height", canopy_.base_height, canopy_height_map_, canopy_height_file_);
-    read_quantity("bulk_density", canopy_.bulk_density, canopy_density_map_, canopy_density_file_);
+    read_layer("base_height", base_height_layer_, LandscapeBand::canopy_base_height, true);
+    read_layer("bulk_density", bulk_density_layer_, LandscapeBand::canopy_bulk_density, true);
+    read_layer("cover", cover_layer_, LandscapeBand::canopy_cover, false);
+    read_layer("height", height_layer_, LandscapeBand::canopy_height, false);
     const double foliar = c.number("foliar_moisture");
     const std::string problem = moisture_percent_problem(foliar);
     if (!problem.empty()) c.fail("foliar_moisture", problem);
@@ -626,9 +655,18 @@ class FireModel final : public VelocityModel {
 
   Canopy canopy_at(double x, double y) const {
     Canopy canopy = canopy_;
-    if (canopy_height_map_.cols > 0) canopy.base_height = std::max(0.0, canopy_height_map_.sample(x, y));
-    if (canopy_density_map_.cols > 0) canopy.bulk_density = std::max(0.0, canopy_density_map_.sample(x, y));
+    canopy.base_height = std::max(0.0, base_height_layer_.at(x, y));
+    canopy.bulk_density = std::max(0.0, bulk_density_layer_.at(x, y));
     return canopy;
+  }
+
+  // The canopy's shelter from the wind at (x, y): its cover and height, and the crown ratio with
+  // its base; none without a cover and a height.
+  Sheltering sheltering_at(double x, double y) const {
+    const double height = height_layer_.at(x, y), cover = cover_layer_.at(x, y) / 100;
+    if (!(height > 0) || !(cover > 0)) return {};
+    const double base = std::clamp(base_height_layer_.at(x, y), 0.0, height);
+    return {.cover = cover, .canopy_height = height, .crown_ratio = (height - base) / height};
   }
 
   // The state's outline, once per iteration (sub-steps and retried steps compute on the same
@@ -682,11 +720,12 @@ class FireModel final : public VelocityModel {
   // A raster of the model in the surface's coordinate system: one in the DEM's own system when the
   // case reprojected the DEM is warped like it (`resampling`: nearest for codes), one in another
   // system is an InputError naming both files, one without a system is taken as the surface's.
-  HeightGrid read_model_raster(const std::filesystem::path& file, Resampling resampling) const {
+  HeightGrid read_model_raster(const std::filesystem::path& file, Resampling resampling,
+                               std::optional<LandscapeBand> band = std::nullopt) const {
     DemReadOptions options;
     if (!surface_.reprojected_from.empty())
       options = {.reproject = Reprojection::utm, .target_crs = surface_.crs, .resampling = resampling};
-    HeightGrid grid = read_dem(file, options);
+    HeightGrid grid = band ? read_landscape_band(file, *band, options) : read_dem(file, options);
     if (grid.crs.empty() && !surface_.crs.empty())
       spdlog::warn("{}: no coordinate system: its cells are taken as in the surface's ({})", file.string(),
                    crs_label(surface_.crs, surface_.file));
@@ -766,11 +805,13 @@ class FireModel final : public VelocityModel {
       const SurfaceFire bed = per_vertex ? surface_fire(models_[std::size_t(fuel)], moisture, false)
                                          : beds_[std::size_t(fuel)];
       const Vec3 wind = wind_.at(x, time);
-      spreads_[i] = head_spread_on_terrain(bed, normals[v], wind, midflame_factor(wind_height_, bed.depth), spread_options_);
+      const Sheltering shelter = has_canopy_ ? sheltering_at(x[0], x[1]) : Sheltering{};
+      spreads_[i] = head_spread_on_terrain(bed, normals[v], wind, midflame_factor(wind_height_, bed.depth, shelter),
+                                           spread_options_);
       heats_[i] = bed.heat_per_unit_area;
       if (!has_canopy_) return;
       // The crown fire over it: the 20-ft wind (a midflame wind goes back up by the bed's factor).
-      const double waf = wind_adjustment_factor(bed.depth);
+      const double waf = wind_adjustment_factor(bed.depth, shelter);
       const double to_20ft = wind_height_ == WindHeight::twenty_feet ? 1.0
                              : wind_height_ == WindHeight::ten_metres ? 1 / 1.15
                              : waf > 0                                ? 1 / waf
@@ -835,9 +876,16 @@ class FireModel final : public VelocityModel {
   ScalarField heats_;                            ///< rothermel: heat per unit area at the vertices, kJ/m²
   ScalarField types_;                            ///< rothermel with a canopy: FireType at the vertices
   bool has_canopy_ = false;                      ///< [model.canopy]: crown fire
-  Canopy canopy_;                                ///< its constant values
-  HeightGrid canopy_height_map_, canopy_density_map_;
-  std::filesystem::path canopy_height_file_, canopy_density_file_;
+  Canopy canopy_;                                ///< its foliar moisture
+  /// A canopy quantity: a number, or a raster (of [model.canopy] or a band of the landscape).
+  struct CanopyLayer {
+    double value = 0;
+    HeightGrid map{};
+    std::filesystem::path file{};
+    double at(double x, double y) const { return map.cols > 0 ? map.sample(x, y) : value; }
+  };
+  CanopyLayer base_height_layer_, bulk_density_layer_, cover_layer_, height_layer_;
+  std::filesystem::path landscape_file_;         ///< rothermel: [model] landscape (a FARSITE .lcp)
   FuelModel fm10_;                               ///< Anderson's model 10 (Rothermel's 1991 crown rate)
   SurfaceFire fm10_bed_;                         ///< under the constant moistures, or at beds_time_
   std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA

@@ -234,17 +234,22 @@ std::string_view wind_height_name(WindHeight height) {
   return "?";
 }
 
-double wind_adjustment_factor(double depth) {
+double wind_adjustment_factor(double depth, const Sheltering& shelter) {
+  const double fill = shelter.cover / 3 * shelter.crown_ratio;
+  if (fill > 0.05 && shelter.canopy_height > 0) {
+    const double h = shelter.canopy_height / kFoot;
+    return 0.555 / (std::sqrt(fill * h) * std::log((20 + 0.36 * h) / (0.13 * h)));
+  }
   if (!(depth > 0)) return 0;
   const double feet = depth / kFoot;
   return 1.83 / std::log((20 + 0.36 * feet) / (0.13 * feet));
 }
 
-double midflame_factor(WindHeight height, double depth) {
+double midflame_factor(WindHeight height, double depth, const Sheltering& shelter) {
   switch (height) {
     case WindHeight::midflame: return 1;
-    case WindHeight::twenty_feet: return wind_adjustment_factor(depth);
-    case WindHeight::ten_metres: return wind_adjustment_factor(depth) / 1.15;
+    case WindHeight::twenty_feet: return wind_adjustment_factor(depth, shelter);
+    case WindHeight::ten_metres: return wind_adjustment_factor(depth, shelter) / 1.15;
   }
   return 1;
 }

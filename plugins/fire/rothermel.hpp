@@ -75,12 +75,20 @@ enum class WindHeight { midflame, twenty_feet, ten_metres };
 /// "midflame", "20ft", "10m"; false for another name.
 bool parse_wind_height(std::string_view name, WindHeight& height);
 std::string_view wind_height_name(WindHeight height);
-/// The unsheltered wind adjustment factor of Albini & Baughman (1979) as BehavePlus uses it
-/// (Andrews 2012): 1.83 / ln((20 + 0.36 δ) / (0.13 δ)), δ the fuel bed depth in ft.
-double wind_adjustment_factor(double depth);
+/// A canopy that shelters the fuel from the wind.
+struct Sheltering {
+  double cover = 0;          ///< canopy cover, fraction
+  double canopy_height = 0;  ///< m
+  double crown_ratio = 0;    ///< (canopy height − base height) / canopy height
+};
+/// The wind adjustment factor of Albini & Baughman (1979) as BehavePlus uses it (Andrews 2012):
+/// unsheltered 1.83 / ln((20 + 0.36 δ) / (0.13 δ)), δ the fuel bed depth in ft; under a canopy whose
+/// crown fill f = cover/3 · crown ratio exceeds 5 %, sheltered 0.555 / (√(f H) ln((20 + 0.36 H) /
+/// (0.13 H))), H the canopy height in ft.
+double wind_adjustment_factor(double depth, const Sheltering& shelter = {});
 /// The midflame wind of a wind measured at `height` over a bed of `depth` (m): a 10-m wind is
 /// 1.15 × the 20-ft wind (Turner & Lawson 1978), a 20-ft wind × the wind adjustment factor.
-double midflame_factor(WindHeight height, double depth);
+double midflame_factor(WindHeight height, double depth, const Sheltering& shelter = {});
 
 }  // namespace bodyfit::fire
 

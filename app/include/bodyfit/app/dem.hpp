@@ -63,9 +63,27 @@ HeightGrid read_esri_ascii_values(const std::filesystem::path& file);
 void write_esri_ascii(const std::filesystem::path& file, const HeightGrid& grid);
 /// GeoTIFF through GDAL; throws InputError when bodyfit was built without GDAL.
 HeightGrid read_geotiff(const std::filesystem::path& file);
-/// Dispatch on extension (.asc, .tif/.tiff); NODATA cells are kept as they are (a raster whose
-/// cells are all NODATA is an error). A geographic raster is refused, or reprojected on request.
+/// Dispatch on extension (.asc, .tif/.tiff, .lcp: a FARSITE landscape's elevation); NODATA cells
+/// are kept as they are (a raster whose cells are all NODATA is an error). A geographic raster is
+/// refused, or reprojected on request.
 HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options = {});
+
+/// The bands of a FARSITE landscape (.lcp), in their order in the file.
+enum class LandscapeBand {
+  elevation = 1,
+  slope,
+  aspect,
+  fuel,
+  canopy_cover,
+  canopy_height,
+  canopy_base_height,
+  canopy_bulk_density
+};
+/// A band of a FARSITE landscape through GDAL, in SI units as its header declares them: elevation
+/// and canopy heights in m (from m, ft, m×10 or ft×10), canopy cover in %, bulk density in kg/m³
+/// (from kg/m³, lb/ft³, kg/m³×100 or lb/ft³×1000), fuel codes as they are; NODATA kept; a unit it
+/// does not know is an error naming the file and band. Reprojected like read_dem on request.
+HeightGrid read_landscape_band(const std::filesystem::path& file, LandscapeBand band, const DemReadOptions& options = {});
 /// The coordinate system of the terrain read_dem(file, options) makes (WKT, "" when unknown), and
 /// the raster's own when read_dem reprojects it ("" otherwise).
 struct DemCoordinates {
