@@ -184,3 +184,59 @@ TEST_CASE("a run: a moisture series that crosses extinction stops the fire at th
   CHECK(areas[6] > 3 * areas[0]);                                 // it grew while dry
   CHECK(areas[12] == doctest::Approx(areas[7]).epsilon(0.01));    // and not after the rain
 }
+
+TEST_CASE("moistures per fuel: a fuel's row replaces the field's moistures for that fuel only") {
+  test::TempDir dir("moisture_per_fuel");
+  std::ofstream(dir / "per_fuel.csv") << "code,dead_1h,dead_10h,dead_100h,live_herb,live_woody\n102,30,30,30,200,200\n";
+  FuelMoisture d1l1;
+  REQUIRE(moisture_scenario("D1L1", d1l1));
+  MoistureField m = MoistureField::constant(d1l1);
+  m.read_per_fuel(dir / "per_fuel.csv");
+  CHECK(m.at(0, 0, 0, 102).value[dead_1h] == doctest::Approx(0.30));
+  CHECK(m.at(0, 0, 0, 101).value[dead_1h] == doctest::Approx(0.03));
+  CHECK(m.at(0, 0, 0).value[dead_1h] == doctest::Approx(0.03));
+  auto error_of = [&](const std::string& text) {
+    std::ofstream(dir / "bad.csv") << text;
+    try {
+      m.read_per_fuel(dir / "bad.csv");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string at = (dir / "bad.csv").string();
+  const std::string header = "code,dead_1h,dead_10h,dead_100h,live_herb,live_woody\n";
+  CHECK(error_of(header + "102,5,6,7,60,90\n102,5,6,7,60,90\n") == at + ":3: code 102 is given twice");
+  CHECK(error_of(header + "1.5,5,6,7,60,90\n") == at + ":2: code: 1.5 is not a fuel code (a positive integer)");
+  CHECK(error_of(header + "102,5,6,0.07,60,90\n").starts_with(at + ":2: dead_100h: 0.07 looks like a fraction"));
+
+  // In a run: GR2 at its extinction by its row stays as it was lit.
+  std::ofstream(dir / "case.toml") << kFlatCase << "[model.moisture]\nscenario = 'D1L1'\nper_fuel = 'per_fuel.csv'\n";
+  const auto result = test::run_bodyfit(fmt::format("run {} -o {}", (dir / "case.toml").string(), (dir / "out").string()));
+  REQUIRE_MESSAGE(result.exit_code == 0, result.output);
+  const std::vector<double> areas = areas_of(dir / "out" / "history.csv");
+  CHECK(areas.back() == doctest::Approx(areas.front()).epsilon(0.01));
+}
+
+TEST_CASE("a moisture raster in another coordinate system than the fuel map is refused, naming both") {
+  test::TempDir dir("moisture_crs");
+  const std::string grid = "ncols 24\nnrows 24\nxllcorner -1200\nyllcorner -1200\ncellsize 100\nNODATA_value -9999\n";
+  std::string fuel = grid, wet = grid;
+  for (int i = 0; i < 24; ++i) {
+    for (int j = 0; j < 24; ++j) fuel += "102 ", wet += "5 ";
+    fuel += "\n", wet += "\n";
+  }
+  std::ofstream(dir / "fuel.asc") << fuel;
+  std::ofstream(dir / "fuel.prj") << test::utm_prj(32);
+  std::ofstream(dir / "m1h.asc") << wet;
+  std::ofstream(dir / "m1h.prj") << test::utm_prj(31);
+  std::string text = kFlatCase;
+  text.replace(text.find("model = \"GR2\""), std::string("model = \"GR2\"").size(), "map = 'fuel.asc'");
+  std::ofstream(dir / "case.toml") << text << "[model.moisture]\ndead_1h_map = 'm1h.asc'\ndead_10h = 6.0\n"
+                                   << "dead_100h = 7.0\nlive_herb = 60.0\nlive_woody = 90.0\n";
+  const auto result = test::run_bodyfit(fmt::format("run {} -o {}", (dir / "case.toml").string(), (dir / "out").string()));
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("fuel.asc and") != std::string::npos);
+  CHECK(result.output.find("m1h.asc have different coordinate systems") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "out" / "history.csv"));
+}

@@ -374,22 +374,13 @@ TEST_CASE("dem: malformed ESRI ASCII grids name the file and the line") {
 }
 
 /// The ESRI WKT of WGS 84 / UTM zone `zone` north, as `gdalsrsinfo -o wkt_esri EPSG:326zz` writes it.
-std::string utm_prj(int zone) {
-  return fmt::format(
-      "PROJCS[\"WGS_1984_UTM_Zone_{}N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\","
-      "6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION["
-      "\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],"
-      "PARAMETER[\"Central_Meridian\",{}.0],PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\","
-      "0.0],UNIT[\"Meter\",1.0]]",
-      zone, 6 * zone - 183);
-}
 
 TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone to use, a projected one kept and written") {
   bodyfit::test::TempDir dir("dem_crs");
   HeightGrid g = plane_grid();
   if (!config::have_gdal) {
     write_esri_ascii(dir / "g.asc", g);
-    write_text(dir / "g.prj", utm_prj(32));
+    write_text(dir / "g.prj", test::utm_prj(32));
     CHECK_THROWS_WITH_AS(read_dem(dir / "g.asc"), doctest::Contains("without GDAL"), InputError);
     return;
   }
@@ -406,7 +397,7 @@ TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone
   CHECK_THROWS_WITH_AS(read_dem(dir / "deg.asc"), doctest::Contains("EPSG:32632"), InputError);
   // A projected system in US feet is refused too.
   write_esri_ascii(dir / "feet.asc", g);
-  std::string feet = utm_prj(18);
+  std::string feet = test::utm_prj(18);
   feet.replace(feet.find("UNIT[\"Meter\",1.0]"), std::string("UNIT[\"Meter\",1.0]").size(),
                "UNIT[\"Foot_US\",0.3048006096012192]");
   write_text(dir / "feet.prj", feet);
@@ -414,7 +405,7 @@ TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone
 
   // UTM: kept with the grid, written beside what is written, the same system when read back.
   write_esri_ascii(dir / "utm.asc", g);
-  write_text(dir / "utm.prj", utm_prj(32));
+  write_text(dir / "utm.prj", test::utm_prj(32));
   HeightGrid utm = read_dem(dir / "utm.asc");
   REQUIRE(!utm.crs.empty());
   write_esri_ascii(dir / "copy.asc", utm);
@@ -424,7 +415,7 @@ TEST_CASE("dem: coordinate systems — geographic ones refused with the UTM zone
   CHECK_NOTHROW(require_same_crs(utm, dir / "utm.asc", copy, dir / "copy.asc"));
   // Another zone is another system: an error naming both files; an unknown system matches any.
   write_esri_ascii(dir / "zone31.asc", g);
-  write_text(dir / "zone31.prj", utm_prj(31));
+  write_text(dir / "zone31.prj", test::utm_prj(31));
   HeightGrid zone31 = read_dem(dir / "zone31.asc");
   CHECK_THROWS_WITH_AS(require_same_crs(utm, dir / "utm.asc", zone31, dir / "zone31.asc"),
                        doctest::Contains("zone31.asc"), InputError);

@@ -8,6 +8,8 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/parameters.hpp>
 
+#include "test_support.hpp"
+
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -246,4 +248,50 @@ TEST_CASE("fuel tables and moistures: bad input is an error naming the file, lin
   CHECK(moisture_error("[moisture]\ndead_1h = 6\n").find("live") == std::string::npos);  // names the missing dead_10h first
   CHECK(moisture_error("[moisture]\ndead_1h = 6\n").find("dead_10h") != std::string::npos);
   CHECK(moisture_error("[moisture]\nscenario = 'D1L1'\ndead_1h = 6\n").find("not several") != std::string::npos);
+}
+
+TEST_CASE("bodyfit ros: the calculator's units, JSON, Balbi's presets and its errors") {
+  auto json_number = [](const std::string& json, const std::string& key) {
+    const std::size_t at = json.find("\"" + key + "\": ");
+    REQUIRE_MESSAGE(at != std::string::npos, key);
+    return std::stod(json.substr(at + key.size() + 4));
+  };
+  // 10 mi/h at 20 ft over GR2 (1 ft bed): the library's head spread at 4.4704 m/s × the bed's factor.
+  const auto gr2 = test::run_bodyfit("ros --fuel GR2 --scenario D1L1 --wind 10 --wind-unit mph --wind-height 20ft --json");
+  REQUIRE_MESSAGE(gr2.exit_code == 0, gr2.output);
+  FuelMoisture d1l1;
+  REQUIRE(moisture_scenario("D1L1", d1l1));
+  const FuelModel& model = *fuel_table("scott_burgan40").find("GR2");
+  const SurfaceFire fire = surface_fire(model, d1l1);
+  const double midflame = 4.4704 * wind_adjustment_factor(model.depth);
+  const HeadSpread s = head_spread(fire, Vec3(midflame, 0, 0), Vec3(1, 0, 0), 0);
+  CHECK(json_number(gr2.output, "midflame_wind_mps") == doctest::Approx(midflame).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "ros_head_mps") == doctest::Approx(s.head).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "ros_back_mps") == doctest::Approx(s.back).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "ros_flank_mps") == doctest::Approx(s.flank).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "length_to_width") == doctest::Approx(s.length_to_width).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "fireline_intensity_kw_per_m") ==
+        doctest::Approx(fire.heat_per_unit_area * s.head).epsilon(1e-8));
+  CHECK(json_number(gr2.output, "flame_length_m") > 0);
+  // km/h and m/s give the same midflame wind for the same speed.
+  const auto kmh = test::run_bodyfit("ros --fuel GR2 --scenario D1L1 --wind 16.09344 --wind-unit km/h --wind-height 20ft --json");
+  CHECK(json_number(kmh.output, "ros_head_mps") == doctest::Approx(s.head).epsilon(1e-8));
+  // Balbi's preset on a 30° slope: R(30°) = 2.360116 m/s by hand (docs/reference/fire_model.md).
+  const auto balbi = test::run_bodyfit("ros --model balbi --slope 30 --json");
+  REQUIRE_MESSAGE(balbi.exit_code == 0, balbi.output);
+  CHECK(json_number(balbi.output, "ros_head_mps") == doctest::Approx(2.360116).epsilon(1e-6));
+  CHECK(json_number(balbi.output, "ros_back_mps") == doctest::Approx(0.39801));
+  // Above extinction: 0, and why.
+  const auto wet = test::run_bodyfit("ros --fuel FM1 --m1h 12 --m10h 13 --m100h 14 --mlh 60 --mlw 90 --json");
+  CHECK(json_number(wet.output, "ros_head_mps") == 0);
+  CHECK(wet.output.find("at or above its moisture of extinction") != std::string::npos);
+  // Errors: exit 1 with the reason.
+  const auto fraction = test::run_bodyfit("ros --fuel FM1 --m1h 0.06 --m10h 7 --m100h 8 --mlh 60 --mlw 90");
+  CHECK(fraction.exit_code == 1);
+  CHECK(fraction.output.find("--m1h: 0.06 looks like a fraction") != std::string::npos);
+  const auto unknown = test::run_bodyfit("ros --fuel XX9 --scenario D1L1");
+  CHECK(unknown.exit_code == 1);
+  CHECK(unknown.output.find("--fuel XX9: not a model of the fuel table anderson13, scott_burgan40") != std::string::npos);
+  CHECK(test::run_bodyfit("ros --fuel GR2 --scenario D1L1 --wind-height 3m").exit_code != 0);
+  CHECK(test::run_bodyfit("ros --model balbi --fuel GR2").exit_code == 1);
 }

@@ -3,6 +3,7 @@
 // ellipse, Byram's intensity and flame length): the fire model's own physics, one point at a time.
 #include "commands.hpp"
 
+#include "balbi.hpp"
 #include "crown.hpp"
 #include "fuel.hpp"
 #include "rothermel.hpp"
@@ -24,7 +25,7 @@ using namespace bodyfit;
 using namespace bodyfit::fire;
 
 struct RosArguments {
-  std::string model = "rothermel", fuel, table, table_file, scenario;
+  std::string model = "rothermel", fuel, table, table_file, scenario, preset;
   std::optional<double> moisture[kFuelClasses];
   double wind = 0, slope = 0, wind_direction = 0;
   std::optional<double> canopy_base_height, canopy_bulk_density;
@@ -60,11 +61,51 @@ FuelMoisture moisture_of(const RosArguments& args) {
   return moisture;
 }
 
+// Balbi's rate of spread with one of the paper's parameter sets: tan γ = n·(tan α ŝ + (U/u0) ŵ), so
+// the head runs along that vector at R(atan |v|), the back and the flanks at R0 (γ ≤ 0).
+int balbi_command(const RosArguments& args) {
+  for (const auto& m : args.moisture)
+    if (m) throw InputError("--m1h … --mlw: Balbi's parameter sets take no fuel moistures (give --model rothermel)");
+  if (!args.fuel.empty() || !args.scenario.empty() || args.canopy_base_height || args.canopy_bulk_density)
+    throw InputError("--fuel, --scenario, --cbh, --cbd: Balbi's rate of spread takes a --preset (the paper's "
+                     "constants), not a fuel model");
+  if (args.wind_height != "midflame")
+    throw InputError("--wind-height: Balbi's rate of spread takes the wind at the flame (midflame)");
+  BalbiParameters p;
+  try {
+    p = preset(args.preset.empty() ? "balbi2009" : args.preset);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("--preset: {}", e.what()));
+  }
+  if (!(args.slope >= 0 && args.slope < 90)) throw InputError(fmt::format("--slope {}: expected degrees in [0, 90)", args.slope));
+  const double speed = args.wind * wind_units().at(args.wind_unit);
+  const double angle = args.wind_direction * M_PI / 180;
+  const double tan_slope = std::tan(args.slope * M_PI / 180);
+  const double vx = tan_slope + speed / p.u0 * std::cos(angle), vy = speed / p.u0 * std::sin(angle);
+  const double head = rate_of_spread(std::atan(std::hypot(vx, vy)), p);
+  const double direction = std::hypot(vx, vy) > 0 ? std::atan2(vy, vx) * 180 / M_PI : 0;
+  if (args.json) {
+    fmt::print("{{\"preset\": \"{}\", \"ros_head_mps\": {:.9g}, \"ros_flank_mps\": {:.9g}, \"ros_back_mps\": {:.9g}, "
+               "\"midflame_wind_mps\": {:.9g}, \"length_to_width\": null, \"direction_of_max_spread_deg\": {:.9g}, "
+               "\"fireline_intensity_kw_per_m\": null, \"flame_length_m\": null}}\n",
+               args.preset.empty() ? "balbi2009" : args.preset, head, p.R0, p.R0, speed, direction);
+    return 0;
+  }
+  const double ft_min = 60 / 0.3048;
+  fmt::print("Balbi et al. (2009), preset {} (R0 {:.4f} m/s, A {:.4f}, u0 {:.1f} m/s, v0 {:.4f} m/s)\n",
+             args.preset.empty() ? "balbi2009" : args.preset, p.R0, p.A, p.u0, p.v0);
+  fmt::print("rate of spread  head  {:9.4f} m/s  {:9.2f} ft/min\n", head, head * ft_min);
+  fmt::print("                flank {:9.4f} m/s  {:9.2f} ft/min\n", p.R0, p.R0 * ft_min);
+  fmt::print("                back  {:9.4f} m/s  {:9.2f} ft/min\n", p.R0, p.R0 * ft_min);
+  fmt::print("direction of spread   {:9.1f}° from upslope\n", direction);
+  fmt::print("(no fuel load: no intensity or flame length; the front is the Wulff shape of R(n), not an ellipse)\n");
+  return 0;
+}
+
 int ros_command(const RosArguments& args) {
-  if (args.model != "rothermel")
-    throw InputError(fmt::format("--model {}: the calculator computes rothermel (Balbi's model with fuel physics "
-                                 "is not available yet)",
-                                 args.model));
+  if (args.model == "balbi") return balbi_command(args);
+  if (!args.preset.empty()) throw InputError("--preset: Balbi's parameter sets (give --model balbi)");
+  if (args.fuel.empty()) throw InputError("--fuel: required by --model rothermel (a code or name: GR2, 102, FM1)");
   // Without a table, the shipped ones (their codes and names do not overlap: FM1 is 1, GR1 is 101).
   std::vector<FuelTable> tables;
   if (!args.table_file.empty()) tables.push_back(read_fuel_table(args.table_file));
@@ -164,7 +205,8 @@ bodyfit::cli::Command setup_ros(CLI::App& app) {
                                         "fireline intensity and flame length of a fuel model (Rothermel)");
   auto args = std::make_shared<RosArguments>();
   cmd->add_option("--model", args->model, "rate-of-spread model")->check(CLI::IsMember({"rothermel", "balbi"}))->capture_default_str();
-  cmd->add_option("--fuel", args->fuel, "fuel model: code or name (GR2, 102, FM1)")->required();
+  cmd->add_option("--fuel", args->fuel, "rothermel: fuel model, code or name (GR2, 102, FM1)");
+  cmd->add_option("--preset", args->preset, "balbi: the paper's parameter set (balbi2009, paper_table1)");
   cmd->add_option("--fuel-table", args->table_file, "a fuel table of your own (CSV with units in the header)");
   cmd->add_option("--table", args->table, "a shipped fuel table (default: the one that has --fuel)")
       ->check(CLI::IsMember(builtin_fuel_tables()));

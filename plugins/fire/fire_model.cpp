@@ -596,7 +596,7 @@ class FireModel final : public VelocityModel {
       code_index_[m.code] = int(models_.size());
       models_.push_back(m);
       if (moisture_.kind() != MoistureField::Kind::constant) return;  // per time or per vertex
-      beds_.push_back(surface_fire(m, moisture_.at(0, 0, 0)));
+      beds_.push_back(surface_fire(m, moisture_.at(0, 0, 0, m.code)));
       const SurfaceFire& bed = beds_.back();
       if (!bed.extinct.empty() && m.burnable()) spdlog::warn("{}", bed.extinct);
     };
@@ -784,9 +784,8 @@ class FireModel final : public VelocityModel {
     if (moisture_.kind() == MoistureField::Kind::series && time != beds_time_) {
       // Moistures in time: every fuel's bed at this (sub-)step's time.
       beds_.clear();
-      const FuelMoisture now = moisture_.at(0, 0, time);
-      for (const FuelModel& m : models_) beds_.push_back(surface_fire(m, now, false));
-      fm10_bed_ = surface_fire(fm10_, now, false);
+      for (const FuelModel& m : models_) beds_.push_back(surface_fire(m, moisture_.at(0, 0, time, m.code), false));
+      fm10_bed_ = surface_fire(fm10_, moisture_.at(0, 0, time), false);
       beds_time_ = time;
     }
     const bool per_vertex = moisture_.kind() == MoistureField::Kind::maps;
@@ -801,9 +800,9 @@ class FireModel final : public VelocityModel {
         return;
       }
       // Moisture rasters: the bed of this vertex's fuel under its own moistures.
-      const FuelMoisture moisture = per_vertex ? moisture_.at(x[0], x[1], time) : FuelMoisture{};
-      const SurfaceFire bed = per_vertex ? surface_fire(models_[std::size_t(fuel)], moisture, false)
-                                         : beds_[std::size_t(fuel)];
+      const FuelModel& model = models_[std::size_t(fuel)];
+      const FuelMoisture moisture = per_vertex ? moisture_.at(x[0], x[1], time, model.code) : FuelMoisture{};
+      const SurfaceFire bed = per_vertex ? surface_fire(model, moisture, false) : beds_[std::size_t(fuel)];
       const Vec3 wind = wind_.at(x, time);
       const Sheltering shelter = has_canopy_ ? sheltering_at(x[0], x[1]) : Sheltering{};
       spreads_[i] = head_spread_on_terrain(bed, normals[v], wind, midflame_factor(wind_height_, bed.depth, shelter),

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -72,7 +73,30 @@ void MoistureField::set_clock(std::optional<double> clock_start) {
   on_clock_ = true;
 }
 
-FuelMoisture MoistureField::at(double x, double y, double t) const {
+void MoistureField::read_per_fuel(const std::filesystem::path& file) {
+  constexpr std::string_view expected = "code,dead_1h,dead_10h,dead_100h,live_herb,live_woody (percent)";
+  const Csv csv = read_csv(file, "the moistures per fuel", expected);
+  require_columns(csv, {"code", "dead_1h", "dead_10h", "dead_100h", "live_herb", "live_woody"}, expected);
+  per_fuel_.clear();
+  for (const CsvRow& row : csv.rows) {
+    const double code = finite_number(csv, row, "code");
+    if (code != std::round(code) || code < 1 || code > 1e9)
+      throw file_error(file, row.line, fmt::format("code: {} is not a fuel code (a positive integer)", code));
+    FuelMoisture m;
+    for (int k = 0; k < kFuelClasses; ++k) {
+      const double percent = finite_number(csv, row, kClassKeys[k]);
+      const std::string problem = moisture_percent_problem(percent);
+      if (!problem.empty()) throw file_error(file, row.line, fmt::format("{}: {}", kClassKeys[k], problem));
+      m.value[std::size_t(k)] = percent / 100;
+    }
+    if (!per_fuel_.emplace(int(code), m).second)
+      throw file_error(file, row.line, fmt::format("code {} is given twice", code));
+  }
+}
+
+FuelMoisture MoistureField::at(double x, double y, double t, int fuel_code) const {
+  if (!per_fuel_.empty())
+    if (const auto it = per_fuel_.find(fuel_code); it != per_fuel_.end()) return it->second;
   switch (kind_) {
     case Kind::constant: return constant_;
     case Kind::series: {
@@ -107,6 +131,8 @@ std::vector<ParameterDecl> moisture_parameters() {
       ParameterDecl::string("moisture.scenario", "Scott & Burgan's moisture scenario D1L1 … D4L4 (dead 3/4/5 % to "
                                                  "12/13/14 %, live herbaceous/woody 30/60 % to 120/150 %), instead of "
                                                  "the five classes"),
+      ParameterDecl::path("moisture.per_fuel", "moistures by fuel code: CSV code,dead_1h,dead_10h,dead_100h,"
+                                               "live_herb,live_woody (percent), replacing the others for those fuels"),
       ParameterDecl::path("moisture.file", "the moistures in time: CSV time,dead_1h,dead_10h,dead_100h,live_herb,"
                                            "live_woody (percent; times in s after t = 0 or ISO 8601), linear in time, "
                                            "the end values held")};
@@ -124,36 +150,38 @@ std::vector<ParameterDecl> moisture_parameters() {
 MoistureField read_moisture(Parameters& m, const RasterReader& read) {
   bool any_class = false;
   for (int k = 0; k < kFuelClasses; ++k) any_class = any_class || m.has(kClassKeys[k]) || m.has(map_key(k));
+  MoistureField field;
   if (m.has("scenario")) {
     const std::string scenario = m.string("scenario");
     if (any_class || m.has("file")) m.fail("scenario", "give either a scenario, the classes or a file, not several");
     FuelMoisture moisture;
     if (!moisture_scenario(scenario, moisture))
       m.fail("scenario", fmt::format("'{}' is not a moisture scenario (D1L1 … D4L4: Scott & Burgan 2005)", scenario));
-    return MoistureField::constant(moisture);
-  }
-  if (m.has("file")) {
+    field = MoistureField::constant(moisture);
+  } else if (m.has("file")) {
     if (any_class) m.fail("file", "give either a file (the moistures in time) or the classes, not both");
-    return MoistureField::series(m.path("file"));
-  }
-  if (!any_class)
-    m.fail("expected the fuel moistures: scenario = \"D2L2\", dead_1h, dead_10h, dead_100h, live_herb and live_woody "
-           "in percent (each a number or a raster: dead_1h_map, …), or file = a series in time");
-  MoistureField field;
-  for (int k = 0; k < kFuelClasses; ++k) {
-    const std::size_t i = std::size_t(k);
-    if (m.has(map_key(k))) {
-      if (m.has(kClassKeys[k])) m.fail(map_key(k), fmt::format("give either {} or {}, not both", kClassKeys[k], map_key(k)));
-      field.map_files_[i] = m.path(map_key(k));
-      field.maps_[i] = read_moisture_raster(field.map_files_[i], read);
-      field.kind_ = MoistureField::Kind::maps;
-      continue;
+    field = MoistureField::series(m.path("file"));
+  } else {
+    if (!any_class)
+      m.fail("expected the fuel moistures: scenario = \"D2L2\", dead_1h, dead_10h, dead_100h, live_herb and "
+             "live_woody in percent (each a number or a raster: dead_1h_map, …), or file = a series in time");
+    for (int k = 0; k < kFuelClasses; ++k) {
+      const std::size_t i = std::size_t(k);
+      if (m.has(map_key(k))) {
+        if (m.has(kClassKeys[k]))
+          m.fail(map_key(k), fmt::format("give either {} or {}, not both", kClassKeys[k], map_key(k)));
+        field.map_files_[i] = m.path(map_key(k));
+        field.maps_[i] = read_moisture_raster(field.map_files_[i], read);
+        field.kind_ = MoistureField::Kind::maps;
+        continue;
+      }
+      const double percent = m.required_number(kClassKeys[k]);
+      const std::string problem = moisture_percent_problem(percent);
+      if (!problem.empty()) m.fail(kClassKeys[k], problem);
+      field.constant_.value[i] = percent / 100;
     }
-    const double percent = m.required_number(kClassKeys[k]);
-    const std::string problem = moisture_percent_problem(percent);
-    if (!problem.empty()) m.fail(kClassKeys[k], problem);
-    field.constant_.value[i] = percent / 100;
   }
+  if (m.has("per_fuel")) field.read_per_fuel(m.path("per_fuel"));
   return field;
 }
 

@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <fmt/format.h>
+
 #include <array>
 #include <atomic>
 #include <cstdio>
@@ -82,6 +84,16 @@ SurfaceMesh grid_square(int n, const GridSquare& o) {
 
 std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(BODYFIT_SOURCE_DIR) / relative;
+}
+
+std::string utm_prj(int zone) {
+  return fmt::format(
+      "PROJCS[\"WGS_1984_UTM_Zone_{}N\",GEOGCS[\"GCS_WGS_1984\",DATUM[\"D_WGS_1984\",SPHEROID[\"WGS_1984\","
+      "6378137.0,298.257223563]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION["
+      "\"Transverse_Mercator\"],PARAMETER[\"False_Easting\",500000.0],PARAMETER[\"False_Northing\",0.0],"
+      "PARAMETER[\"Central_Meridian\",{}.0],PARAMETER[\"Scale_Factor\",0.9996],PARAMETER[\"Latitude_Of_Origin\","
+      "0.0],UNIT[\"Meter\",1.0]]",
+      zone, 6 * zone - 183);
 }
 
 }  // namespace bodyfit::test

@@ -43,4 +43,7 @@ std::string history_without_timings(const std::filesystem::path& file);
 /// Path of a file in the source tree (e.g. "meshes/parts/bracket_h0.07.mesh").
 std::filesystem::path source_path(const std::string& relative);
 
+/// The ESRI WKT (.prj) of WGS 84 / UTM zone `zone` N.
+std::string utm_prj(int zone);
+
 }  // namespace bodyfit::test
