@@ -473,7 +473,7 @@ members = 200
   CHECK(error_of("\"model.u0\" = {dist = \"choice\", values = [1.0, 2.0], weights = [0.0, 0.0]}\n").find("positive sum") != std::string::npos);
 }
 
-TEST_CASE("ensemble: sampling only a fuel moisture gives members of different areas; a fixed one, equal areas") {
+TEST_CASE("ensemble: sampling only a fuel moisture gives members of different areas, a fixed one equal areas") {
   // Rothermel's GR2 on flat ground: where a member's fire starts does not change its area, what it
   // burns with does.
   const std::string base = R"([surface]

@@ -89,7 +89,7 @@ vtu_every = 0
 
 }  // namespace
 
-TEST_CASE("moisture series: linear in time, the ends held, on the run's clock; bad rows name their line") {
+TEST_CASE("moisture series: linear in time, the ends held, on the run's clock, bad rows named by their line") {
   test::TempDir dir("moisture_series");
   std::ofstream(dir / "m.csv") << "time,dead_1h,dead_10h,dead_100h,live_herb,live_woody\n0,4,5,6,60,90\n600,8,9,10,120,150\n";
   MoistureField m = MoistureField::series(dir / "m.csv");
