@@ -517,20 +517,7 @@ live_woody = 90.0
     TempDir dir(name);
     const fs::path file = write_case(dir, base + more);
     ensemble(file, dir / "out");
-    std::ifstream table(dir / "out/members.csv");
-    std::string header, row;
-    std::getline(table, header);
-    const auto columns = [](const std::string& line) {
-      std::vector<std::string> cells;
-      std::stringstream s(line);
-      for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
-      return cells;
-    };
-    const std::vector<std::string> names = columns(header);
-    const std::size_t at = std::size_t(std::find(names.begin(), names.end(), "burnt_area_m2") - names.begin());
-    REQUIRE(at < names.size());
-    std::vector<double> result;
-    while (std::getline(table, row)) result.push_back(std::stod(columns(row)[at]));
+    const std::vector<double> result = test::csv_column(dir / "out/members.csv", "burnt_area_m2");
     REQUIRE(result.size() == 4);
     return result;
   };

@@ -37,26 +37,7 @@ std::string read_error(const std::string& table_text, const fs::path& dir) {
   return "no error";
 }
 
-// The iteration's |G| from a run's history.csv.
-std::vector<double> areas_of(const fs::path& history) {
-  std::ifstream in(history);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  {
-    std::stringstream s(line);
-    for (std::string c; std::getline(s, c, ',');) names.push_back(c);
-  }
-  const std::size_t at = std::size_t(std::find(names.begin(), names.end(), "area") - names.begin());
-  std::vector<double> areas;
-  while (std::getline(in, line)) {
-    std::stringstream s(line);
-    std::string c;
-    for (std::size_t i = 0; i <= at; ++i) std::getline(s, c, ',');
-    areas.push_back(std::stod(c));
-  }
-  return areas;
-}
+std::vector<double> areas_of(const fs::path& history) { return test::csv_column(history, "area"); }
 
 const char* kFlatCase = R"([surface]
 generator = "plane"

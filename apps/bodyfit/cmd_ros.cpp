@@ -141,12 +141,7 @@ int ros_command(const RosArguments& args) {
   CrownFire crown;
   crown.spread = s;
   if (canopy_given) {
-    const double waf = wind_adjustment_factor(fuel->depth);
-    const double to_20ft = height == WindHeight::twenty_feet ? 1.0
-                           : height == WindHeight::ten_metres ? 1 / 1.15
-                           : waf > 0                         ? 1 / waf
-                                                             : 0.0;
-    const double wind_20ft = args.wind * wind_units().at(args.wind_unit) * to_20ft;
+    const double wind_20ft = args.wind * wind_units().at(args.wind_unit) * twenty_foot_factor(height, fuel->depth);
     const SurfaceFire fm10 = surface_fire(*fuel_table("anderson13").find("FM10"), moisture);
     const std::string problem = moisture_percent_problem(args.foliar_moisture);
     if (!problem.empty()) throw InputError("--fmc: " + problem);

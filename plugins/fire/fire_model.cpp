@@ -810,16 +810,11 @@ class FireModel final : public VelocityModel {
       heats_[i] = bed.heat_per_unit_area;
       if (!has_canopy_) return;
       // The crown fire over it: the 20-ft wind (a midflame wind goes back up by the bed's factor).
-      const double waf = wind_adjustment_factor(bed.depth, shelter);
-      const double to_20ft = wind_height_ == WindHeight::twenty_feet ? 1.0
-                             : wind_height_ == WindHeight::ten_metres ? 1 / 1.15
-                             : waf > 0                                ? 1 / waf
-                                                                      : 0.0;
       const TerrainSlope slope = terrain_slope(normals[v]);
       const CrownFire crown =
           crown_fire(spreads_[i], bed.heat_per_unit_area, canopy_at(x[0], x[1]),
                      per_vertex ? surface_fire(fm10_, moisture, false) : fm10_bed_,
-                     tangent_wind(to_20ft * wind, normals[v]), slope.upslope, slope.tan_slope, spread_options_);
+                     tangent_wind(twenty_foot_factor(wind_height_, bed.depth, shelter) * wind, normals[v]), slope.upslope, slope.tan_slope, spread_options_);
       spreads_[i] = crown.spread;
       types_[i] = double(crown.type);
     };

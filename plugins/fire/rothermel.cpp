@@ -254,6 +254,18 @@ double midflame_factor(WindHeight height, double depth, const Sheltering& shelte
   return 1;
 }
 
+double twenty_foot_factor(WindHeight height, double depth, const Sheltering& shelter) {
+  switch (height) {
+    case WindHeight::twenty_feet: return 1;
+    case WindHeight::ten_metres: return 1 / 1.15;
+    case WindHeight::midflame: {
+      const double waf = wind_adjustment_factor(depth, shelter);
+      return waf > 0 ? 1 / waf : 0.0;
+    }
+  }
+  return 1;
+}
+
 }  // namespace bodyfit::fire
 
 namespace bodyfit::fire {

@@ -89,6 +89,9 @@ double wind_adjustment_factor(double depth, const Sheltering& shelter = {});
 /// The midflame wind of a wind measured at `height` over a bed of `depth` (m): a 10-m wind is
 /// 1.15 × the 20-ft wind (Turner & Lawson 1978), a 20-ft wind × the wind adjustment factor.
 double midflame_factor(WindHeight height, double depth, const Sheltering& shelter = {});
+/// The factor that brings a wind measured at `height` to 20 ft (a midflame wind goes back up by
+/// the wind adjustment factor; 0 where that is 0: no bed, no wind to speak of).
+double twenty_foot_factor(WindHeight height, double depth, const Sheltering& shelter = {});
 
 }  // namespace bodyfit::fire
 

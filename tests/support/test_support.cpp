@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include <sys/wait.h>
@@ -84,6 +86,25 @@ SurfaceMesh grid_square(int n, const GridSquare& o) {
 
 std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(BODYFIT_SOURCE_DIR) / relative;
+}
+
+std::vector<double> csv_column(const std::filesystem::path& file, const std::string& name) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  auto cells = [](const std::string& text) {
+    std::vector<std::string> out;
+    std::stringstream s(text);
+    for (std::string cell; std::getline(s, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  const std::vector<std::string> header = cells(line);
+  const auto at = std::size_t(std::find(header.begin(), header.end(), name) - header.begin());
+  if (at == header.size()) throw std::runtime_error(file.string() + ": no column " + name);
+  std::vector<double> values;
+  while (std::getline(in, line))
+    if (!line.empty()) values.push_back(std::stod(cells(line).at(at)));
+  return values;
 }
 
 std::string utm_prj(int zone) {

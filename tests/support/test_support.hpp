@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace bodyfit::test {
 
@@ -42,6 +43,10 @@ std::string history_without_timings(const std::filesystem::path& file);
 
 /// Path of a file in the source tree (e.g. "meshes/parts/bracket_h0.07.mesh").
 std::filesystem::path source_path(const std::string& relative);
+
+/// The values of the column `name` of a CSV file with a header row (a run's history.csv, an
+/// ensemble's members.csv), as numbers.
+std::vector<double> csv_column(const std::filesystem::path& file, const std::string& name);
 
 /// The ESRI WKT (.prj) of WGS 84 / UTM zone `zone` N.
 std::string utm_prj(int zone);
