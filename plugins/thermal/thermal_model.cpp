@@ -13,6 +13,7 @@
 //   state          the objective history, ε and α as resolved, Δt's cap.
 #include "box_field.hpp"
 #include "shape_derivative.hpp"
+#include "sharp_problem.hpp"
 #include "smoothing.hpp"
 #include "thermal_fem.hpp"
 #include "volume_mesh.hpp"
@@ -104,6 +105,9 @@ class ThermalModel final : public VelocityModel {
             .fallback(1e-3)
             .at_least(0),
         ParameterDecl::integer("patience", "steps", "see tolerance").fallback(15).within({.min = 1, .max = 1000000}),
+        ParameterDecl::boolean("sharp", "solve the sharp problem (4.12) on every accepted state's volume mesh "
+                                        "and report J_sharp (one more solve)")
+            .fallback(true),
         ParameterDecl::integer("volume_every", "states", "write volume_NNNNN.vtu (tetrahedra with u) every k states (0: "
                                                          "never)")
             .fallback(0)
@@ -126,6 +130,10 @@ class ThermalModel final : public VelocityModel {
             OutputDecl::metric("ms_assembly", "ms", "set-up and assembly"),
             OutputDecl::metric("ms_factor", "ms", "analysis and factorisation"),
             OutputDecl::metric("ms_solve", "ms", "solves"),
+            OutputDecl::metric("T_sharp", "temperature", "the mean temperature of the sharp problem (4.12): u = 0 on "
+                                                         "G's faces (sharp = true)"),
+            OutputDecl::metric("J_sharp", "temperature", "T_sharp + ell·|G|: the objective J_ε approximates"),
+            OutputDecl::metric("ms_sharp", "ms", "the sharp problem's assembly and solve"),
             OutputDecl::vertex_field("temperature", "temperature", "u at the surface's vertices"),
             OutputDecl::vertex_field("adjoint", "", "p at the surface's vertices"),
             OutputDecl::vertex_field("shape_gradient", "", "the density w of J′ on the surface"),
@@ -160,6 +168,7 @@ class ThermalModel final : public VelocityModel {
     tolerance_ = p.number("tolerance");
     patience_ = int(p.integer("patience"));
     volume_every_ = int(p.integer("volume_every"));
+    sharp_ = p.boolean("sharp");
   }
 
   ModelNeeds needs() const override { return {.may_reject = true, .freeze_velocity = true}; }
@@ -242,6 +251,20 @@ class ThermalModel final : public VelocityModel {
     write_volume(*next, candidate);
     const ThermalObjective& o = next->objective;
     const ThermalTimings& t = next->solution.timings;
+    // The true objective beside the smoothed one: u = 0 on G's faces of the same volume mesh.
+    double T_sharp = std::numeric_limits<double>::quiet_NaN(), ms_sharp = 0;
+    if (sharp_) {
+      FaceMask g(candidate.mesh().n_faces(), 0);
+      for (auto f : candidate.mesh().faces()) g[std::size_t(f.idx())] = candidate.mesh().inside(f);
+      ThermalProblem problem = base_problem(candidate.mesh());
+      try {
+        const SharpSolution sharp = solve_sharp(next->volume, problem, g, solver_);
+        T_sharp = sharp.mean_temperature;
+        ms_sharp = sharp.ms;
+      } catch (const InputError& error) {
+        spdlog::warn("thermal, step {}: no sharp J ({})", candidate.iteration(), error.what());
+      }
+    }
     Review r = converged() ? Review::accept_and_stop(fmt::format(
                                  "converged: the best J improved by less than {:g} (relative) over the last {} steps "
                                  "(J = {:.8g}, best {:.8g})",
@@ -259,7 +282,10 @@ class ThermalModel final : public VelocityModel {
                  {"ms_tetgen", next->ms_tetrahedralize},
                  {"ms_assembly", t.setup_ms + t.assembly_ms},
                  {"ms_factor", t.analysis_ms + t.factorization_ms},
-                 {"ms_solve", t.solve_ms}};
+                 {"ms_solve", t.solve_ms},
+                 {"T_sharp", T_sharp},
+                 {"J_sharp", T_sharp + ell_ * o.area},
+                 {"ms_sharp", ms_sharp}};
     current_ = std::move(next);  // T^{n+1} is the next compute's state
     return r;
   }
@@ -326,17 +352,11 @@ class ThermalModel final : public VelocityModel {
     }
     e->ms_tetrahedralize = ms_since(start);
 
-    ThermalProblem problem;
-    if (!conductivity_.constant() || conductivity_.value != 1) problem.conductivity = conductivity_;
-    if (!source_.constant() || source_.value != 1) problem.source = source_;
+    ThermalProblem problem = base_problem(mesh);
     problem.robin_field = context.distance();
     const double epsilon = epsilon_;
     problem.robin_coefficient = [epsilon](double d) { return h_epsilon(d, epsilon); };
-    const FaceMask neumann = neumann_faces(mesh);
-    if (!neumann.empty()) {
-      problem.neumann = neumann;
-      problem.neumann_flux = neumann_;  // g: a box's value on its faces
-    }
+    const FaceMask neumann = problem.neumann;
     ThermalOptions options;
     options.linear = solver_;
     try {
@@ -349,6 +369,20 @@ class ThermalModel final : public VelocityModel {
     for (auto edge : mesh.edges())
       if (mesh.interface(edge)) e->interface_length += mesh.calc_edge_length(edge);
     return e;
+  }
+
+  /// The part's conductivity, source and Neumann boxes on `mesh` (the smoothed problem adds its
+  /// Robin term, the sharp one holds G at 0).
+  ThermalProblem base_problem(const SurfaceMesh& mesh) const {
+    ThermalProblem problem;
+    if (!conductivity_.constant() || conductivity_.value != 1) problem.conductivity = conductivity_;
+    if (!source_.constant() || source_.value != 1) problem.source = source_;
+    const FaceMask neumann = neumann_faces(mesh);
+    if (!neumann.empty()) {
+      problem.neumann = neumann;
+      problem.neumann_flux = neumann_;  // g: a box's value on its faces
+    }
+    return problem;
   }
 
   /// b_Σ = ∫_Σ φ_i dℓ: half of each interface edge's length to each of its ends.
@@ -401,6 +435,7 @@ class ThermalModel final : public VelocityModel {
   LinearSolverOptions solver_;
   double armijo_ = 1e-4, noise_ = 0.01, min_step_factor_ = 0.0625, grow_ = 1.2, max_dt_factor_ = 4, tolerance_ = 1e-3;
   int patience_ = 15, volume_every_ = 0;
+  bool sharp_ = true;  ///< J_sharp of every accepted state
   // State (saved in checkpoints).
   std::vector<double> history_;  ///< J of every accepted state, from T^0
   double alpha_length_ = 0;      ///< α·h
