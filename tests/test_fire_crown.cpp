@@ -116,6 +116,15 @@ vtu_every = 0
   // Every burnt cell of the crown run burnt as an active crown fire (NODATA where burning at t = 0).
   CHECK(fs::exists(dir / "crown" / "fire_type.tif"));
   CHECK_FALSE(fs::exists(dir / "surface" / "fire_type.tif"));
+  // A canopy raster with a negative cell: refused, naming the cell.
+  std::ofstream(dir / "cbd.asc") << "ncols 2\nnrows 1\nxllcorner -1500\nyllcorner -1500\ncellsize 1500\n"
+                                    "NODATA_value -9999\n0.2 -0.1\n";
+  std::ofstream(dir / "bad.toml") << test::read_file(dir / "crown.toml");
+  const std::string bad = test::read_file(dir / "bad.toml");
+  std::ofstream(dir / "bad.toml") << bad.substr(0, bad.find("bulk_density = 0.2")) << "bulk_density_map = 'cbd.asc'\n";
+  const auto refused = test::run_bodyfit(fmt::format("run {} -o {}", (dir / "bad.toml").string(), (dir / "bad").string()));
+  CHECK(refused.exit_code == 1);
+  CHECK(refused.output.find("cbd.asc: the bulk_density of the cell at row 1, column 2 is negative (-0.1)") != std::string::npos);
 }
 
 TEST_CASE("sheltered wind adjustment: Albini & Baughman's factor under a canopy, unsheltered below 5 % fill") {

@@ -229,6 +229,8 @@ TEST_CASE("fuel tables and moistures: bad input is an error naming the file, lin
   no_unit.replace(no_unit.find("depth[ft]"), 9, "depth");
   CHECK(table_error(no_unit + good).starts_with("fuels.csv:1: column 'depth' has no unit"));
   CHECK(table_error(header + "1,A,no,1,0,0,0,0,2000,0,0,1,0.2,8000,8000\n") == "no error");  // 0.2 % is odd, not wrong
+  CHECK(table_error(header + "1,A,no,1,0,0,0,0,2000,0,0,0,20,8000,8000\n") ==
+        "fuels.csv:2: depth: 0 for a model with fuel (expected the fuel bed's depth > 0)");
   CHECK(table_error(header + "x,A,no,1,0,0,0,0,2000,0,0,1,20,8000,8000\n").starts_with("fuels.csv:2: code: 'x' is not"));
 
   auto moisture_error = [](const std::string& text) -> std::string {

@@ -641,6 +641,12 @@ class FireModel final : public VelocityModel {
       } else {
         return;
       }
+      // A canopy raster holds heights, densities or a cover: none is negative.
+      for (std::size_t row = 0; row < layer.map.rows; ++row)
+        for (std::size_t col = 0; col < layer.map.cols; ++col)
+          if (layer.map.valid(row, col) && layer.map.at(row, col) < 0)
+            throw InputError(fmt::format("{}: the {} of the cell at row {}, column {} is negative ({})",
+                                         layer.file.string(), key, row + 1, col + 1, layer.map.at(row, col)));
       fill_nodata(layer.map);
     };
     read_layer("base_height", base_height_layer_, LandscapeBand::canopy_base_height, true);
@@ -655,8 +661,8 @@ class FireModel final : public VelocityModel {
 
   Canopy canopy_at(double x, double y) const {
     Canopy canopy = canopy_;
-    canopy.base_height = std::max(0.0, base_height_layer_.at(x, y));
-    canopy.bulk_density = std::max(0.0, bulk_density_layer_.at(x, y));
+    canopy.base_height = base_height_layer_.at(x, y);
+    canopy.bulk_density = bulk_density_layer_.at(x, y);
     return canopy;
   }
 

@@ -129,6 +129,10 @@ FuelTable table_from(const Csv& csv, const std::string& source) {
     m.extinction_moisture = quantity("extinction_moisture");
     m.heat_dead = quantity("heat_dead");
     m.heat_live = quantity("heat_live");
+    double total_load = 0;
+    for (double w : m.load) total_load += w;
+    if (total_load > 0 && !(m.depth > 0))
+      throw file_error(csv.file, row.line, "depth: 0 for a model with fuel (expected the fuel bed's depth > 0)");
     if (m.dynamic && m.load[live_herb] == 0)
       throw file_error(csv.file, row.line, "dynamic: yes, but the model has no live herbaceous load to cure");
     if (m.burnable()) {
