@@ -205,4 +205,19 @@ ScalarField ArrivalRaster::sample_at_vertices(const SurfaceMesh& mesh) const {
   return values;
 }
 
+GridField grid_field(const HeightGrid& grid, std::string description,
+                     std::vector<std::pair<std::string, std::string>> items, const std::string& crs) {
+  GridField field;
+  field.cols = grid.cols, field.rows = grid.rows;
+  field.x_origin = grid.x_origin, field.y_origin = grid.y_origin;
+  field.cell_size = grid.cell_size;
+  field.values = grid.heights;
+  for (double& v : field.values)
+    if (v == grid.nodata) v = std::numeric_limits<double>::quiet_NaN();
+  field.crs = crs;
+  field.description = std::move(description);
+  field.items = std::move(items);
+  return field;
+}
+
 }  // namespace bodyfit::fire

@@ -2,6 +2,7 @@
 // Spatial data of the fire model: raster lookups and the arrival-time raster (the wind: wind.hpp).
 #include <bodyfit/app/terrain.hpp>
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/model_outputs.hpp>
 #include <bodyfit/model_state.hpp>
 
 #include <cstdint>
@@ -11,6 +12,10 @@
 #include <vector>
 
 namespace bodyfit::fire {
+
+/// A raster of the model as a grid output, in the coordinate system `crs` (NODATA cells as NaN).
+GridField grid_field(const HeightGrid& grid, std::string description,
+                     std::vector<std::pair<std::string, std::string>> items, const std::string& crs);
 
 /// Value of the cell containing (x, y) (clamped to the raster).
 double raster_nearest(const HeightGrid& grid, double x, double y);

@@ -3,11 +3,8 @@
 // wind and the orientation of the front (extended conormal n_Σ of the context).
 #include "balbi.hpp"
 #include "barriers.hpp"
-#include "crown.hpp"
 #include "fire_maps.hpp"
-#include "fuel.hpp"
-#include "moisture.hpp"
-#include "rothermel.hpp"
+#include "rothermel_spread.hpp"
 #include "wind.hpp"
 
 #include <bodyfit/app/clock_time.hpp>
@@ -30,7 +27,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <unordered_map>
 
 namespace bodyfit::fire {
 namespace {
@@ -97,22 +93,6 @@ std::vector<Perimeter> load_perimeters(const ModelState& state) {
     perimeters.push_back(std::move(p));
   }
   return perimeters;
-}
-
-/// A raster of the model as a grid output, in its coordinate system.
-GridField grid_field(const HeightGrid& grid, std::string description,
-                     std::vector<std::pair<std::string, std::string>> items, const std::string& crs) {
-  GridField field;
-  field.cols = grid.cols, field.rows = grid.rows;
-  field.x_origin = grid.x_origin, field.y_origin = grid.y_origin;
-  field.cell_size = grid.cell_size;
-  field.values = grid.heights;
-  for (double& v : field.values)
-    if (v == grid.nodata) v = std::numeric_limits<double>::quiet_NaN();
-  field.crs = crs;
-  field.description = std::move(description);
-  field.items = std::move(items);
-  return field;
 }
 
 class FireModel final : public VelocityModel {
@@ -243,7 +223,6 @@ class FireModel final : public VelocityModel {
 
   void configure(Parameters& p) override {
     rothermel_ = p.choice("spread") == "rothermel";
-    has_canopy_ = false;
     arrival_.record({});
     huygens_ = p.choice("front_velocity") == "huygens";
     surface_slope_ = p.choice("slope") == "surface";
@@ -261,10 +240,16 @@ class FireModel final : public VelocityModel {
     }
     fuel_map_ = HeightGrid();
     fuel_file_.clear();
-    landscape_file_.clear();
     non_burnable_.clear();
-    if (rothermel_) configure_rothermel(p);
-    else configure_balbi(p);
+    if (rothermel_) {
+      rothermel_spread_.configure(p, [&](const std::filesystem::path& file, Resampling resampling,
+                                         std::optional<LandscapeBand> band) {
+        return read_model_raster(file, resampling, band);
+      });
+      arrival_.record(rothermel_spread_.recorded_names());
+    } else {
+      configure_balbi(p);
+    }
     if (p.has("fuel")) {
       Parameters& f = p.section("fuel");
       for (double code : f.numbers("non_burnable")) {
@@ -278,8 +263,8 @@ class FireModel final : public VelocityModel {
         check_fuel_codes();
       }
     }
-    if (!landscape_file_.empty()) {  // a FARSITE landscape's fuel band (rothermel)
-      fuel_file_ = landscape_file_;
+    if (rothermel_ && !rothermel_spread_.landscape().empty()) {  // a FARSITE landscape's fuel band
+      fuel_file_ = rothermel_spread_.landscape();
       fuel_map_ = read_model_raster(fuel_file_, Resampling::nearest, LandscapeBand::fuel);
       check_fuel_codes();
     }
@@ -312,11 +297,8 @@ class FireModel final : public VelocityModel {
     if (fuel_map_.cols > 0) rasters.emplace_back(&fuel_map_, fuel_file_);
     for (const auto& raster : wind_.rasters()) rasters.push_back(raster);
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
-    if (rothermel_) {
-      for (const auto& raster : moisture_.rasters()) rasters.push_back(raster);
-      for (const CanopyLayer* layer : {&base_height_layer_, &bulk_density_layer_, &cover_layer_, &height_layer_})
-        if (layer->map.cols > 0) rasters.emplace_back(&layer->map, layer->file);
-    }
+    if (rothermel_)
+      for (const auto& raster : rothermel_spread_.rasters()) rasters.push_back(raster);
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
     std::filesystem::path first_file;
@@ -355,16 +337,12 @@ class FireModel final : public VelocityModel {
       if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
       mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
     }
-    if (rothermel_) {
-      moisture_.set_clock(context.clock_start());
-      update_spreads(mesh, normals, active, time);
-    }
+    if (rothermel_)
+      rothermel_spread_.update(mesh, normals, active, time, context.clock_start(), wind_, wind_height_,
+                               [&](double x, double y) { return fuel_at(x, y); });
     auto rate_in = [&](int v, const Vec3& n_sigma) {
       if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
-      if (rothermel_) {
-        const HeadSpread& spread = spreads_[std::size_t(v)];
-        return n_sigma.sqrnorm() == 0 ? spread.flank : ellipse_normal_rate(spread, n_sigma);
-      }
+      if (rothermel_) return rothermel_spread_.rate(v, n_sigma);
       const Vec3& x = mesh.point(VertexHandle(v));
       const int index = fuel_at(x[0], x[1]);
       if (index < 0) return 0.0;  // not burnable: the front stops here
@@ -459,13 +437,10 @@ class FireModel final : public VelocityModel {
     // rates_ (those of the state before): its cells arrive at that time with no rate of spread.
     if (arrival_.initialised()) {
       const bool current = outcome.dt > 0 && rates_.size() == outcome.mesh.n_vertices();
-      const std::size_t n = outcome.mesh.n_vertices();
-      const ScalarField* recorded[] = {current && heats_.size() == n ? &heats_ : nullptr,
-                                       current && types_.size() == n ? &types_ : nullptr};
+      std::vector<const ScalarField*> recorded;
+      if (rothermel_ && current) recorded = rothermel_spread_.recorded(outcome.mesh.n_vertices());
       arrival_.update(outcome.mesh, outcome.distance, outcome.phi_next, outcome.time, outcome.dt, outcome.changed,
-                      current ? &rates_ : nullptr,
-                      rothermel_ ? std::span<const ScalarField* const>(recorded, has_canopy_ ? 2 : 1)
-                                 : std::span<const ScalarField* const>());
+                      current ? &rates_ : nullptr, recorded);
     }
   }
 
@@ -505,7 +480,7 @@ class FireModel final : public VelocityModel {
                                           "burning at the start)",
                                           rothermel_ ? "Rothermel" : "Balbi"),
                               items, crs_));
-      if (rothermel_) write_intensity_grids(outputs, items);
+      if (rothermel_) rothermel_spread_.write_grids(outputs, arrival_, items, crs_);
     }
     if (output_dir.empty()) return;
     write_perimeters(output_dir);
@@ -562,117 +537,6 @@ class FireModel final : public VelocityModel {
         f.fail("presets", e.what());
       }
     }
-  }
-
-  // Rothermel's fuel beds: the fuel table's models under the case's moistures; Balbi's keys refused.
-  void configure_rothermel(Parameters& p) {
-    p.forbid({"preset", "R0", "A", "u0", "v0", "max_tilt_deg"},
-             "to spread = \"rothermel\" (Balbi's parameters: Rothermel's come from the fuel table)");
-    spread_options_.limit_effective_wind = p.boolean("limit_effective_wind");
-    moisture_ = read_moisture(p.section("moisture"), [&](const std::filesystem::path& file) {
-      return read_model_raster(file, Resampling::bilinear);
-    });
-    Parameters& f = p.section("fuel");
-    f.forbid({"presets"}, "to spread = \"rothermel\" (Balbi's parameter sets: Rothermel's fuels are the table's)");
-    if (f.has("table_file")) {
-      if (f.has("table")) f.fail("table", "give either fuel.table or fuel.table_file");
-      table_ = read_fuel_table(f.path("table_file"));
-    } else {
-      table_ = fuel_table(f.choice("table"));
-    }
-    beds_.clear();
-    models_.clear();
-    code_index_.clear();
-    beds_time_ = std::numeric_limits<double>::quiet_NaN();
-    if (p.has("landscape")) {
-      landscape_file_ = p.path("landscape");
-      if (f.has("model") || f.has("map"))
-        f.fail(f.has("model") ? "model" : "map", "the fuel comes from [model] landscape (its fuel band): give either");
-    } else if (f.has("model") == f.has("map")) {
-      f.fail("expected either fuel.model (one fuel everywhere, e.g. \"GR2\"), fuel.map (a raster of the fuel "
-             "table's codes) or [model] landscape (a FARSITE landscape)");
-    }
-    auto add_bed = [&](const FuelModel& m) {
-      code_index_[m.code] = int(models_.size());
-      models_.push_back(m);
-      if (moisture_.kind() != MoistureField::Kind::constant) return;  // per time or per vertex
-      beds_.push_back(surface_fire(m, moisture_.at(0, 0, 0, m.code)));
-      const SurfaceFire& bed = beds_.back();
-      if (!bed.extinct.empty() && m.burnable()) spdlog::warn("{}", bed.extinct);
-    };
-    configure_canopy(p);
-    fm10_ = *fuel_table("anderson13").find("FM10");
-    if (moisture_.kind() == MoistureField::Kind::constant) fm10_bed_ = surface_fire(fm10_, moisture_.at(0, 0, 0));
-    std::vector<std::string> recorded = {"heat_per_unit_area"};
-    if (has_canopy_) recorded.push_back("fire_type");
-    arrival_.record(recorded);
-    if (f.has("model")) {
-      const std::string name = f.string("model");
-      const FuelModel* m = table_.find(name);
-      if (!m) f.fail("model", fmt::format("'{}' is not a model of the fuel table {}", name, table_.source));
-      add_bed(*m);
-    } else {
-      for (const FuelModel& m : table_.models) add_bed(m);
-    }
-  }
-
-  // [model.canopy]: the canopy base height and bulk density (numbers or rasters) and the foliar
-  // moisture, for crown fire; no table, no crown fire.
-  void configure_canopy(Parameters& p) {
-    canopy_ = Canopy{};
-    for (CanopyLayer* layer : {&base_height_layer_, &bulk_density_layer_, &cover_layer_, &height_layer_}) *layer = {};
-    const bool landscape = !landscape_file_.empty();
-    has_canopy_ = p.has("canopy") || landscape;
-    if (!has_canopy_) return;
-    Parameters& c = p.section("canopy");
-    // A quantity: a number, a raster, or a band of the landscape (in that order of precedence).
-    auto read_layer = [&](const char* key, CanopyLayer& layer, std::optional<LandscapeBand> band, bool required) {
-      const std::string map_key = std::string(key) + "_map";
-      if (c.has(map_key)) {
-        if (c.has(key)) c.fail(map_key, fmt::format("give either {} or {}, not both", key, map_key));
-        layer.file = c.path(map_key);
-        layer.map = read_model_raster(layer.file, Resampling::bilinear);
-      } else if (c.has(key) || (required && !landscape)) {
-        layer.value = c.required_number(key);
-        return;
-      } else if (band && landscape) {
-        layer.file = landscape_file_;
-        layer.map = read_model_raster(landscape_file_, Resampling::bilinear, band);
-      } else {
-        return;
-      }
-      // A canopy raster holds heights, densities or a cover: none is negative.
-      for (std::size_t row = 0; row < layer.map.rows; ++row)
-        for (std::size_t col = 0; col < layer.map.cols; ++col)
-          if (layer.map.valid(row, col) && layer.map.at(row, col) < 0)
-            throw InputError(fmt::format("{}: the {} of the cell at row {}, column {} is negative ({})",
-                                         layer.file.string(), key, row + 1, col + 1, layer.map.at(row, col)));
-      fill_nodata(layer.map);
-    };
-    read_layer("base_height", base_height_layer_, LandscapeBand::canopy_base_height, true);
-    read_layer("bulk_density", bulk_density_layer_, LandscapeBand::canopy_bulk_density, true);
-    read_layer("cover", cover_layer_, LandscapeBand::canopy_cover, false);
-    read_layer("height", height_layer_, LandscapeBand::canopy_height, false);
-    const double foliar = c.number("foliar_moisture");
-    const std::string problem = moisture_percent_problem(foliar);
-    if (!problem.empty()) c.fail("foliar_moisture", problem);
-    canopy_.foliar_moisture = foliar / 100;
-  }
-
-  Canopy canopy_at(double x, double y) const {
-    Canopy canopy = canopy_;
-    canopy.base_height = base_height_layer_.at(x, y);
-    canopy.bulk_density = bulk_density_layer_.at(x, y);
-    return canopy;
-  }
-
-  // The canopy's shelter from the wind at (x, y): its cover and height, and the crown ratio with
-  // its base; none without a cover and a height.
-  Sheltering sheltering_at(double x, double y) const {
-    const double height = height_layer_.at(x, y), cover = cover_layer_.at(x, y) / 100;
-    if (!(height > 0) || !(cover > 0)) return {};
-    const double base = std::clamp(base_height_layer_.at(x, y), 0.0, height);
-    return {.cover = cover, .canopy_height = height, .crown_ratio = (height - base) / height};
   }
 
   // The state's outline, once per iteration (sub-steps and retried steps compute on the same
@@ -753,7 +617,7 @@ class FireModel final : public VelocityModel {
         const bool integer = value == std::round(value) && std::abs(value) < 1e15;
         if (integer && (non_burnable(std::llround(value)) || fuel_of_code(std::llround(value)) >= 0)) continue;
         const std::string fuels =
-            rothermel_ ? fmt::format("a code of the fuel table {}", table_.source)
+            rothermel_ ? fmt::format("a code of the fuel table {}", rothermel_spread_.table().source)
                        : fmt::format("a preset's number (1 to {}: [model.fuel] presets)", fuels_.size());
         throw InputError(fmt::format("{}: the fuel code {} of the cell at row {}, column {} is neither {} nor 0, NODATA "
                                      "({}) or a code of [model.fuel] non_burnable",
@@ -763,10 +627,7 @@ class FireModel final : public VelocityModel {
 
   // The fuel of a code of the map: an index into fuels_ (balbi) or beds_ (rothermel), −1 for none.
   int fuel_of_code(long long code) const {
-    if (rothermel_) {
-      const auto it = code_index_.find(code);
-      return it == code_index_.end() ? -1 : it->second;
-    }
+    if (rothermel_) return rothermel_spread_.fuel_of_code(code);
     return code >= 1 && std::size_t(code) <= fuels_.size() ? int(code - 1) : -1;
   }
 
@@ -780,83 +641,6 @@ class FireModel final : public VelocityModel {
   }
   const BalbiParameters& balbi_fuel(int index) const { return fuels_.empty() ? base_ : fuels_[std::size_t(index)]; }
 
-  // Rothermel's fire ellipse at the vertices R is needed at (the band's, or all): fuel, slope and
-  // wind are the vertex's, the direction of the front is applied by ellipse_normal_rate.
-  void update_spreads(const SurfaceMesh& mesh, const VectorField& normals, std::span<const int> active, double time) {
-    const std::size_t n = mesh.n_vertices();
-    spreads_.resize(n);
-    heats_.resize(n, 0.0);
-    if (has_canopy_) types_.resize(n, double(FireType::surface));
-    if (moisture_.kind() == MoistureField::Kind::series && time != beds_time_) {
-      // Moistures in time: every fuel's bed at this (sub-)step's time.
-      beds_.clear();
-      for (const FuelModel& m : models_) beds_.push_back(surface_fire(m, moisture_.at(0, 0, time, m.code), false));
-      fm10_bed_ = surface_fire(fm10_, moisture_.at(0, 0, time), false);
-      beds_time_ = time;
-    }
-    const bool per_vertex = moisture_.kind() == MoistureField::Kind::maps;
-    auto update = [&](int v) {
-      const std::size_t i = std::size_t(v);
-      const Vec3& x = mesh.point(VertexHandle(v));
-      const int fuel = fuel_at(x[0], x[1]);
-      if (fuel < 0) {
-        spreads_[i] = HeadSpread{};
-        heats_[i] = 0;
-        if (has_canopy_) types_[i] = double(FireType::surface);
-        return;
-      }
-      // Moisture rasters: the bed of this vertex's fuel under its own moistures.
-      const FuelModel& model = models_[std::size_t(fuel)];
-      const FuelMoisture moisture = per_vertex ? moisture_.at(x[0], x[1], time, model.code) : FuelMoisture{};
-      const SurfaceFire bed = per_vertex ? surface_fire(model, moisture, false) : beds_[std::size_t(fuel)];
-      const Vec3 wind = wind_.at(x, time);
-      const Sheltering shelter = has_canopy_ ? sheltering_at(x[0], x[1]) : Sheltering{};
-      spreads_[i] = head_spread_on_terrain(bed, normals[v], wind, midflame_factor(wind_height_, bed.depth, shelter),
-                                           spread_options_);
-      heats_[i] = bed.heat_per_unit_area;
-      if (!has_canopy_) return;
-      // The crown fire over it: the 20-ft wind (a midflame wind goes back up by the bed's factor).
-      const TerrainSlope slope = terrain_slope(normals[v]);
-      const CrownFire crown =
-          crown_fire(spreads_[i], bed.heat_per_unit_area, canopy_at(x[0], x[1]),
-                     per_vertex ? surface_fire(fm10_, moisture, false) : fm10_bed_,
-                     tangent_wind(twenty_foot_factor(wind_height_, bed.depth, shelter) * wind, normals[v]), slope.upslope, slope.tan_slope, spread_options_);
-      spreads_[i] = crown.spread;
-      types_[i] = double(crown.type);
-    };
-    if (!active.empty())
-      for (int v : active) update(v);
-    else
-      for (int v = 0; v < int(n); ++v) update(v);
-  }
-
-  // Byram's fireline intensity, flame length and the heat per unit area of the cells that burnt
-  // (the heat recorded as the front crossed each, times the rate it crossed at), and with a canopy
-  // the fire type there.
-  void write_intensity_grids(ModelOutputs& outputs, const std::vector<std::pair<std::string, std::string>>& items) const {
-    const HeightGrid& rate = arrival_.rate_grid();
-    const HeightGrid& heat = arrival_.recorded(0);
-    HeightGrid intensity = rate, flame = rate, type = rate;
-    for (std::size_t cell = 0; cell < rate.heights.size(); ++cell) {
-      const double r = rate.heights[cell], h = heat.heights[cell];
-      const bool burnt = std::isfinite(r) && std::isfinite(h);
-      intensity.heights[cell] = burnt ? fireline_intensity(h, r) : std::numeric_limits<double>::quiet_NaN();
-      flame.heights[cell] = burnt ? flame_length(intensity.heights[cell]) : std::numeric_limits<double>::quiet_NaN();
-      if (has_canopy_) {
-        const double t = arrival_.recorded(1).heights[cell];
-        type.heights[cell] = burnt && std::isfinite(t) ? std::round(t) : std::numeric_limits<double>::quiet_NaN();
-      }
-    }
-    outputs.grid("heat_per_unit_area", grid_field(heat, "heat per unit area released, kJ/m² (Rothermel)", items, crs_));
-    outputs.grid("fireline_intensity",
-                 grid_field(intensity, "Byram's fireline intensity at which the cell burnt, kW/m", items, crs_));
-    outputs.grid("flame_length", grid_field(flame, "Byram's flame length at which the cell burnt, m", items, crs_));
-    if (has_canopy_)
-      outputs.grid("fire_type", grid_field(type, "fire type where the cell burnt: 1 surface, 2 passive crown, 3 active "
-                                                 "crown (Van Wagner 1977, Rothermel 1991)",
-                                           items, crs_));
-  }
-
   SurfaceSource surface_;  ///< what S was built from (set_surface): its CRS is the case's
   Barriers barriers_;
   double barrier_reach_ = 0;   ///< of the state's own compute (barrier_reach)
@@ -864,30 +648,8 @@ class FireModel final : public VelocityModel {
   bool rothermel_ = false;  ///< spread: Rothermel's ellipse (true) or Balbi's (4.8)
   BalbiParameters base_;
   std::vector<BalbiParameters> fuels_;
-  FuelTable table_;                              ///< rothermel: the fuel models
-  MoistureField moisture_;                       ///< rothermel: [model.moisture]
-  std::vector<FuelModel> models_;                ///< rothermel: the fuels the run may meet
-  std::vector<SurfaceFire> beds_;                ///< rothermel: their beds under constant moistures, or at beds_time_
-  double beds_time_ = std::numeric_limits<double>::quiet_NaN();
-  std::unordered_map<long long, int> code_index_;  ///< rothermel: fuel code → beds_ index
-  SpreadOptions spread_options_;
+  RothermelSpread rothermel_spread_;  ///< spread = "rothermel": fuels, moistures, canopy, the ellipse
   WindHeight wind_height_ = WindHeight::midflame;
-  std::vector<HeadSpread> spreads_;              ///< rothermel: the ellipse at the vertices (update_spreads)
-  ScalarField heats_;                            ///< rothermel: heat per unit area at the vertices, kJ/m²
-  ScalarField types_;                            ///< rothermel with a canopy: FireType at the vertices
-  bool has_canopy_ = false;                      ///< [model.canopy]: crown fire
-  Canopy canopy_;                                ///< its foliar moisture
-  /// A canopy quantity: a number, or a raster (of [model.canopy] or a band of the landscape).
-  struct CanopyLayer {
-    double value = 0;
-    HeightGrid map{};
-    std::filesystem::path file{};
-    double at(double x, double y) const { return map.cols > 0 ? map.sample(x, y) : value; }
-  };
-  CanopyLayer base_height_layer_, bulk_density_layer_, cover_layer_, height_layer_;
-  std::filesystem::path landscape_file_;         ///< rothermel: [model] landscape (a FARSITE .lcp)
-  FuelModel fm10_;                               ///< Anderson's model 10 (Rothermel's 1991 crown rate)
-  SurfaceFire fm10_bed_;                         ///< under the constant moistures, or at beds_time_
   std::vector<long long> non_burnable_;  ///< codes of the fuel map that do not burn, besides 0 and NODATA
   HeightGrid fuel_map_;
   WindField wind_;
