@@ -325,7 +325,7 @@ class FireModel final : public VelocityModel {
       wind_.center = 0.5 * (box.min + box.max);
       wind_.has_center = true;
     }
-    // A wind series is a function of time: V at the time of this (sub-)step (docs/reference/fire_model.md, "Wind").
+    // A wind series is a function of time: V at the time of this (sub-)step (docs/reference/fire_model.md, "Wind in time").
     wind_.set_clock(context.clock_start());
     const double time = context.time();
     if (context.is_height_field() && !arrival_.initialised()) arrival_.initialise(mesh, arrival_cell_, arrival_like_, context.mesh_size());
