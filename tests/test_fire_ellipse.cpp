@@ -93,7 +93,7 @@ double minkowski_area(double a1, double b1, double a2, double b2) {
 
 TEST_CASE("fire_ellipse.toml: a point ignition under a uniform wind burns the exact ellipse, hour by hour") {
   // The case's fuel, moisture and wind (GR1, D1L1, 10 mi/h at 20 ft from the west).
-  const fire::FuelModel& gr1 = *fire::fuel_table("scott_burgan40").find("GR1");
+  const fire::FuelModel gr1 = *fire::fuel_table("scott_burgan40").find("GR1");  // a copy: the table is a temporary
   fire::FuelMoisture moisture;
   REQUIRE(fire::moisture_scenario("D1L1", moisture));
   const double midflame = 4.4704 * fire::midflame_factor(fire::WindHeight::twenty_feet, gr1.depth);
@@ -175,7 +175,7 @@ TEST_CASE("a point ignition on a uniform slope burns the exact ellipse of slope 
   // in which the exact region is the ignition (a horizontal disk: an ellipse of semi-axes r0/cos α
   // upslope, r0 across) swept by the fire's ellipse.
   const double alpha = 30 * M_PI / 180, r0 = 50, ignition_x = -800;
-  const fire::FuelModel& gr1 = *fire::fuel_table("scott_burgan40").find("GR1");
+  const fire::FuelModel gr1 = *fire::fuel_table("scott_burgan40").find("GR1");  // a copy: the table is a temporary
   fire::FuelMoisture moisture;
   REQUIRE(fire::moisture_scenario("D1L1", moisture));
   const fire::HeadSpread spread =
