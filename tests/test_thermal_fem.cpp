@@ -2,6 +2,7 @@
 // finite elements against exact solutions, the adjoint, the shape derivative against finite
 // differences of J_ε, and the inputs that must fail with a clear message.
 #include "linear_solver.hpp"
+#include "thermal_fixtures.hpp"
 #include "quadrature.hpp"
 #include "shape_derivative.hpp"
 #include "smoothing.hpp"
@@ -29,49 +30,11 @@
 
 using namespace bodyfit;
 using namespace bodyfit::thermal;
+using bodyfit::test::DiskOnCube;
+using bodyfit::test::make_box;
+using bodyfit::test::unit_sphere;
 
 namespace {
-
-/// The surface of the box [lo, hi] on an n×n grid per face (diagonals alternating), outward, all
-/// faces outside G. Appended to `mesh` (a separate component) when given.
-SurfaceMesh make_box(int n, Vec3 lo, Vec3 hi, SurfaceMesh mesh = {}) {
-  std::map<std::array<int, 3>, VertexHandle> lattice;
-  auto vertex = [&](std::array<int, 3> ijk) {
-    auto it = lattice.find(ijk);
-    if (it != lattice.end()) return it->second;
-    Vec3 p;
-    for (int k = 0; k < 3; ++k) p[k] = lo[k] + (hi[k] - lo[k]) * ijk[std::size_t(k)] / n;
-    return lattice[ijk] = mesh.add_vertex(p);
-  };
-  for (int a = 0; a < 3; ++a)
-    for (int side : {0, n}) {
-      int b = (a + 1) % 3, c = (a + 2) % 3;
-      auto at = [&](int u, int v) {
-        std::array<int, 3> ijk{};
-        ijk[std::size_t(a)] = side, ijk[std::size_t(b)] = u, ijk[std::size_t(c)] = v;
-        return vertex(ijk);
-      };
-      for (int u = 0; u < n; ++u)
-        for (int v = 0; v < n; ++v) {
-          // (u,v) → (u+1,v) → (u+1,v+1) turns counterclockwise seen from +e_a (e_b × e_c = e_a).
-          VertexHandle q[4] = {at(u, v), at(u + 1, v), at(u + 1, v + 1), at(u, v + 1)};
-          std::array<std::array<int, 3>, 2> tris = (u + v) % 2 ? std::array<std::array<int, 3>, 2>{{{0, 1, 2}, {0, 2, 3}}}
-                                                                : std::array<std::array<int, 3>, 2>{{{0, 1, 3}, {1, 2, 3}}};
-          for (auto t : tris) {
-            if (side == 0) std::swap(t[1], t[2]);
-            auto f = mesh.add_face(q[t[0]], q[t[1]], q[t[2]]);
-            mesh.region(f) = kOutside;
-          }
-        }
-    }
-  return mesh;
-}
-
-SurfaceMesh unit_sphere(std::size_t faces) {
-  auto s = make_sphere({.faces = faces});
-  for (auto f : s.faces()) s.region(f) = kOutside;
-  return s;
-}
 
 double mean_edge(const SurfaceMesh& mesh) { return edge_length_stats(mesh).mean; }
 
@@ -395,35 +358,6 @@ TEST_CASE("adjoint: p = -u/|Omega| when f = 1, gamma = 1, no Neumann part, every
 }
 
 // ---- the shape derivative ------------------------------------------------------------------------------
-
-namespace {
-
-/// Cube [−1,1]³ (16 cells a side) whose region G is the disk of radius R on the face z = 1, away
-/// from the edges, so that d = r − R on that face and ≥ ε everywhere else (h_ε = 0 there: any value
-/// ≥ ε will do).
-struct DiskOnCube {
-  SurfaceMesh surface;
-  double R;
-  explicit DiskOnCube(double radius) : surface(make_box(16, {-1, -1, -1}, {1, 1, 1})), R(radius) {
-    for (auto f : surface.faces()) {
-      auto [a, b, c] = face_points(surface, f);
-      const Vec3 centroid = (a + b + c) / 3;
-      const bool top = a[2] == 1 && b[2] == 1 && c[2] == 1;
-      surface.region(f) = top && std::hypot(centroid[0], centroid[1]) < R ? kInside : kOutside;
-    }
-  }
-  /// d for a disk of radius `radius` (the labels stay those of R).
-  std::vector<double> distance(double radius) const {
-    std::vector<double> d(surface.n_vertices());
-    for (auto vh : surface.vertices()) {
-      const Vec3& p = surface.point(vh);
-      d[std::size_t(vh.idx())] = p[2] == 1 ? std::hypot(p[0], p[1]) - radius : 10.0;
-    }
-    return d;
-  }
-};
-
-}  // namespace
 
 TEST_CASE("shape derivative: band formula against central finite differences of J_eps, J decreases as G grows") {
   // The disk on the cube (DiskOnCube). Moving R by δ moves d by −δ (s ≡ −1); G's labels, hence ℓ|G|,

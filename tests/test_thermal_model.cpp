@@ -5,8 +5,12 @@
 // clear error.
 #include "test_support.hpp"
 
-#include <doctest/doctest.h>
+#include <bodyfit/io.hpp>
 
+#include <doctest/doctest.h>
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -29,8 +33,9 @@ name = "thermal"
 ell = 0.02
 epsilon = 0.3
 noise = 0.0        # strict Armijo: every accepted step decreases J
-armijo = 0.5       # half the slope: the first step (dt = 0.4) falls 2.7 % short of it by the
-                   # descent's curvature, not by noise, and is retried with dt = 0.2
+armijo = 0.9       # 90 % of the slope: the first step (dt = 0.4, a front motion of 0.4 against
+                   # h = 0.15) falls short of it by the descent's curvature, not by noise, and is
+                   # retried with dt = 0.2, 0.1, ...
 [time]
 dt = 0.4
 iterations = 6     # short of the optimum (J 3.21 -> 0.44), where J's decrease is the cut's noise
@@ -155,8 +160,136 @@ iterations = 2
   auto neumann = run("--set model.neumann.boxes=[[-2,-2,-2,2,2,2,0.0]]");
   CHECK(neumann.exit_code == 1);
   CHECK_MESSAGE(neumann.output.find("covers all") != std::string::npos, neumann.output);
+  // A target area out of range, or given twice.
+  auto above = run("--set model.area.target=100");
+  CHECK(above.exit_code == 1);
+  CHECK_MESSAGE(above.output.find("target = 100 is not below |S|") != std::string::npos, above.output);
+  auto below = run("--set model.area.target=-1");
+  CHECK(below.exit_code == 1);
+  CHECK_MESSAGE(below.output.find("target") != std::string::npos, below.output);
+  auto both = run("--set model.area.target=1 --set model.area.fraction=0.2");
+  CHECK(both.exit_code == 1);
+  CHECK_MESSAGE(both.output.find("give one of target") != std::string::npos, both.output);
+  // An objective region outside the part, or none.
+  auto outside = run("--set model.objective.kind=\"region_mean\" --set model.objective.boxes=[[5,5,5,6,6,6]]");
+  CHECK(outside.exit_code == 1);
+  CHECK_MESSAGE(outside.output.find("contain no tetrahedron") != std::string::npos, outside.output);
+  auto no_boxes = run("--set model.objective.kind=\"region_mean\"");
+  CHECK(no_boxes.exit_code == 1);
+  CHECK_MESSAGE(no_boxes.output.find("needs at least one box") != std::string::npos, no_boxes.output);
+  // An exponent for an objective that has none is refused, not ignored.
+  auto unused = run("--set model.objective.kind=\"mean_temperature\" --set model.objective.exponent=4");
+  CHECK(unused.exit_code == 1);
+  CHECK_MESSAGE(unused.output.find("exponent") != std::string::npos, unused.output);
+  // ε below the mesh size without the sharp solve; a continuation that grows ε.
+  auto thin = run("--set model.epsilon=0.05 --set model.sharp=false");
+  CHECK(thin.exit_code == 1);
+  CHECK_MESSAGE(thin.output.find("epsilon = 0.05 is below the mesh size") != std::string::npos, thin.output);
+  auto grows = run("--set model.epsilon_final=0.5");
+  CHECK(grows.exit_code == 1);
+  CHECK_MESSAGE(grows.output.find("epsilon_final") != std::string::npos, grows.output);
   // An unknown key, with a suggestion.
   auto typo = run("--set model.epsilom=0.1");
   CHECK(typo.exit_code == 1);
   CHECK(typo.output.find("did you mean 'epsilon'") != std::string::npos);
+}
+
+namespace {
+
+/// One step of length dt from T⁰ that is always taken (armijo = 0, noise = 1): J⁰, J¹, the slope
+/// J′(v) the model predicted, |G⁰|, |G¹| and ∫_Σ v.
+struct OneStep {
+  double J0, J1, slope, A0, A1, area_rate;
+};
+
+OneStep one_step(const bodyfit::test::TempDir& dir, const std::string& case_file, double dt) {
+  const std::string out = (dir / "step").string();
+  auto run = bodyfit::test::run_bodyfit(fmt::format("run {} -o {} --overwrite --set time.iterations=1 --set time.dt={} "
+                                                    "--set model.armijo=0 --set model.noise=1",
+                                                    case_file, out, dt));
+  REQUIRE_MESSAGE(run.exit_code == 0, run.output);
+  const Table history = read_csv(dir / "step" / "history.csv");
+  const Table objective = read_csv(dir / "step" / "objective.csv");
+  REQUIRE(history.size() == 2);
+  auto at = [](const std::map<std::string, std::string>& row, const char* key) { return std::stod(row.at(key)); };
+  return {at(objective[0], "J"), at(history[1], "J"), at(history[1], "slope"), at(objective[0], "area_G"),
+          at(history[1], "area_G"), at(history[1], "area_rate")};
+}
+
+}  // namespace
+
+TEST_CASE("Taylor test through the whole pipeline: realised over predicted dJ within 5 % of 1 from h/8 down to the "
+          "remesh floor, and the area term on its own") {
+  // The plugin's velocity, redistancing, advection, cut, remesh and a new tetrahedralisation: J¹ − J⁰
+  // against Δt·J′(v) for Δt = h/2 … h/32 (h = 0.15). The floor is the change of J over a step of
+  // 1e-7 (the front does not move; the mesh is cut, remeshed and tetrahedralised anew); a ratio is
+  // checked where the predicted change is at least ten times the floor.
+  // Measured: floor ΔJ = −2.6e-3 (8e-4 of J); ratios 0.86, 0.94, 0.98, 1.02, 1.01; area 1.07, 1.05, 1.06.
+  bodyfit::test::TempDir dir("thermal_taylor");
+  const std::string case_file = write_case(dir, kSphere);
+  const double h = 0.15;
+  const OneStep still = one_step(dir, case_file, 1e-7);
+  const double floor = std::abs(still.J1 - still.J0);
+  MESSAGE(fmt::format("remesh floor: |ΔJ| = {:.3e} ({:.2e} of J) over a step of 1e-7", floor, floor / still.J0));
+  CHECK(floor < 2e-3 * still.J0);
+  std::vector<double> ratios;
+  for (int k : {2, 4, 8, 16, 32}) {
+    const double dt = h / k;
+    const OneStep s = one_step(dir, case_file, dt);
+    const double predicted = dt * s.slope, realised = s.J1 - s.J0;
+    const double area = (s.A1 - s.A0) / (dt * s.area_rate);
+    MESSAGE(fmt::format("dt = h/{}: realised {:.5e}, predicted {:.5e}, ratio {:.4f}; area: ratio {:.4f}", k, realised,
+                        predicted, realised / predicted, area));
+    CHECK(s.slope < 0);
+    ratios.push_back(realised / predicted);
+    if (k >= 8 && std::abs(predicted) >= 10 * floor) CHECK(std::abs(realised / predicted - 1) <= 0.05);
+    // The ℓ term: |G| changes by Δt·∫_Σ v, up to the second-order term of a growing cap.
+    if (k <= 8) CHECK(std::abs(area - 1) <= 0.1);
+  }
+  // The ratio tends to 1 as Δt shrinks (the first-order term of the remainder).
+  CHECK(std::abs(ratios[0] - 1) > std::abs(ratios[2] - 1));
+}
+
+TEST_CASE("thermal optimisation with a target area: the augmented Lagrangian holds |G| to 30 % of |S|, steadily") {
+  bodyfit::test::TempDir dir("thermal_target");
+  const std::string case_file = write_case(dir, R"(
+[surface]
+generator = "sphere"
+h = 0.15
+[region]
+shape = "cap"
+axis = [0, 0, 1]
+angle = 30
+[model]
+name = "thermal"
+ell = 0.0
+epsilon = 0.3
+[model.area]
+fraction = 0.3
+[time]
+dt = 0.075
+iterations = 150
+[output]
+vtu_every = 0
+)");
+  auto run = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "out").string());
+  REQUIRE_MESSAGE(run.exit_code == 0, run.output);
+  CHECK(run.output.find("stalled") != std::string::npos);  // a normal end, before the iteration count
+  const Table rows = read_csv(dir / "out" / "history.csv");
+  REQUIRE(rows.size() > 12);
+  const bodyfit::SurfaceMesh final_mesh = bodyfit::read_mesh(dir / "out" / "final.mesh");
+  double sphere = 0;  // |S|
+  for (auto f : final_mesh.faces()) sphere += final_mesh.calc_face_area(f);
+  const double last = std::stod(rows.back().at("area_G"));
+  MESSAGE(fmt::format("|G| = {:.5f} = {:.4f} |S| after {} iterations, lambda = {}", last, last / sphere, rows.size() - 1,
+                      rows.back().at("lambda")));
+  CHECK(std::abs(last / sphere - 0.3) < 0.005);
+  CHECK(std::stod(rows.back().at("lambda")) > 0);  // the constraint holds G back from growing
+  // Steady: |G| varies by at most 1 % over the last 10 iterations.
+  double lo = 1e300, hi = 0;
+  for (std::size_t i = rows.size() - 10; i < rows.size(); ++i) {
+    lo = std::min(lo, std::stod(rows[i].at("area_G")));
+    hi = std::max(hi, std::stod(rows[i].at("area_G")));
+  }
+  CHECK((hi - lo) / lo <= 0.01);
 }

@@ -1,6 +1,7 @@
 // The sharp problem (4.12) on the body-fitted volume mesh: u = 0 on G exactly. Against the exact
 // solution on the ball held at 0 on its whole sphere, and the smoothed problem's T_ε → T as ε → 0.
 #include "sharp_problem.hpp"
+#include "thermal_fixtures.hpp"
 #include "smoothing.hpp"
 #include "thermal_fem.hpp"
 #include "volume_mesh.hpp"
@@ -18,14 +19,9 @@
 
 using namespace bodyfit;
 using namespace bodyfit::thermal;
+using bodyfit::test::unit_sphere;
 
 namespace {
-
-SurfaceMesh unit_sphere(std::size_t faces) {
-  auto s = make_sphere({.faces = faces});
-  for (auto f : s.faces()) s.region(f) = kOutside;
-  return s;
-}
 
 double order(double e0, double e1, double h0, double h1) { return std::log(e0 / e1) / std::log(h0 / h1); }
 

@@ -1,5 +1,6 @@
 #pragma once
-// The objective J_ε(G) = T_ε(G) + ℓ|G| of the paper (4.13) and its shape derivative in band form:
+// The objective J_ε(G) = j(u_ε) + ℓ|G| (the paper's (4.13) for j = T, the mean temperature) and its
+// shape derivative in band form:
 //
 //   J′_ε(G)(θ) = ∫_S w (θ·n_Σ)∘π_Σ ds + ℓ ∫_Σ θ·n_Σ dℓ,    w = −(1/ε²) h′(d_G/ε) u p,
 //
@@ -30,7 +31,8 @@ struct ObjectiveOptions {
 };
 
 struct ThermalObjective {
-  double J = 0;     ///< T + ℓ·area
+  double J = 0;     ///< j + ℓ·area
+  double j = 0;     ///< the functional j(u) (objective.hpp; T for the mean temperature)
   double T = 0;     ///< mean temperature (1/|Ω|)∫_Ω u
   double area = 0;  ///< |G|: area of the faces labelled inside
   /// w at the surface vertices: −(1/ε²) h′(d/ε) u p (0 on vertices whose faces are all in Γ_N).
@@ -52,5 +54,36 @@ std::vector<double> shape_gradient_density(const std::vector<double>& distance, 
 /// (G's labels, hence ℓ|G|, do not change with d). For s = −(θ·n_Σ)∘π_Σ this is ∫_S w (θ·n_Σ)∘π_Σ.
 double band_derivative(const SurfaceMesh& surface, const std::vector<double>& distance,
                        const std::vector<double>& s, const ThermalSolution& solution, const ObjectiveOptions& options);
+
+/// b_Σ = ∫_Σ φ_i dℓ: half of each interface edge's length to each of its ends (the load of
+/// ∫_Σ θ·n, the derivative of |G|).
+Eigen::VectorXd interface_length_load(const SurfaceMesh& surface);
+
+/// π_Σ, the closest point of Σ's edges, at the vertices within `reach` of Σ: the two ends of the
+/// closest interface edge and the parameter t of the point along it (from `from` to `to`); `from`
+/// is −1 at the vertices beyond reach, and everywhere when S has no interface.
+struct InterfaceProjection {
+  std::vector<int> from, to;
+  std::vector<double> t;
+};
+InterfaceProjection project_onto_interface(const SurfaceMesh& surface, double reach);
+
+/// W_k = ∫_{S\Γ_N} (dh_ε/dd)(d) u p φ_k with the quadrature of the Robin assembly: the gradient of
+/// the discrete T_ε with respect to d at the vertices, band_derivative(s) = Σ_k W_k s_k. −W_k is the
+/// vertex's share of ∫ w (W_k ≈ −m_k w_k with the lumped mass m_k).
+std::vector<double> band_weights(const SurfaceMesh& surface, const std::vector<double>& distance,
+                                 const ThermalSolution& solution, const ObjectiveOptions& options);
+
+/// The band's derivative carried onto Σ along the normals: b_i = −Σ_k W_k φ_i(π_Σ(x_k)). Then bᵀv is
+/// the derivative of the discrete T_ε when d moves by −v∘π_Σ at the vertices — what a step of the
+/// pipeline does: it redistances from the moved Σ, so d moves by −v∘π_Σ, not by −v at each point of
+/// the band (the two differ wherever v varies across the band). InputError when W ≠ 0 at a vertex
+/// beyond the projection's reach (the reach must exceed the band's ε).
+Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights);
+
+/// v∘π_Σ at the projected vertices, v elsewhere: the normal speed constant along Σ's normals, so
+/// that a step moves each point of Σ by its own v·Δt (a semi-Lagrangian step samples the speed
+/// at the front's new position, off Σ, where an H¹ speed with a line load has a kink).
+std::vector<double> extend_from_interface(const InterfaceProjection& projection, const std::vector<double>& v);
 
 }  // namespace bodyfit::thermal

@@ -62,6 +62,7 @@ SharpSolution solve_sharp(const VolumeMesh& mesh, const ThermalProblem& problem,
   const Eigen::VectorXd weights = assemble_volume_weights(mesh);
   s.volume = weights.sum();
   s.mean_temperature = weights.dot(s.u) / s.volume;
+  s.objective = TemperatureFunctional(mesh, problem.objective, K, weights).value(s.u);
   s.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return s;
 }

@@ -4,7 +4,7 @@
 //
 //   −div(γ∇u) = f in Ω,   u = 0 on G,   γ∂u/∂n = g on Γ_N,   γ∂u/∂n = 0 on the rest of S,
 //
-// and T(G) = (1/|Ω|)∫_Ω u, the objective T_ε approximates (T_ε → T as ε → 0). The volume mesh
+// and T(G) = (1/|Ω|)∫_Ω u (or the problem's functional j(u), objective.hpp), the objective T_ε approximates (T_ε → T as ε → 0). The volume mesh
 // keeps S's faces, so G is a set of its boundary faces and the condition is imposed exactly at
 // their vertices.
 #include "thermal_fem.hpp"
@@ -15,6 +15,7 @@ struct SharpSolution {
   Eigen::VectorXd u;            ///< at every volume vertex (0 at G's)
   double volume = 0;            ///< |Ω|
   double mean_temperature = 0;  ///< T(G)
+  double objective = 0;         ///< j(u) of the problem's objective (= T(G) for the mean temperature)
   double ms = 0;                ///< assembly and solve
 };
 

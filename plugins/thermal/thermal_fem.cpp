@@ -7,6 +7,7 @@
 
 #include <array>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -181,6 +182,7 @@ struct ThermalSolver::Impl {
   double volume = 0;
   double setup_ms = 0;
   bool shortcut = false;        // p = −u/|Ω|
+  std::optional<TemperatureFunctional> functional;
   SymmetricSolver solver;
   Eigen::MatrixXd previous;     // the last solution [u p], the conjugate gradient's warm start
 };
@@ -216,7 +218,8 @@ ThermalSolver::ThermalSolver(const VolumeMesh& mesh, ThermalProblem problem, con
     for (std::size_t f = 0; f < pb.neumann.size(); ++f) robin_faces[f] = pb.neumann[f] ? 0 : 1;
     m.state_rhs += assemble_boundary_load(mesh, pb.robin_source, robin_faces, options.quadrature);
   }
-  m.shortcut = options.adjoint_shortcut && !pb.source && !pb.robin_source && (!pb.neumann_flux || neumann_faces == 0);
+  m.functional.emplace(mesh, pb.objective, m.stiffness, m.weights);
+  m.shortcut = options.adjoint_shortcut && pb.objective.kind == ObjectiveKind::mean_temperature && !pb.source && !pb.robin_source && (!pb.neumann_flux || neumann_faces == 0);
   m.setup_ms = ms_since(t0);
 }
 
@@ -229,6 +232,7 @@ const ThermalProblem& ThermalSolver::problem() const { return impl_->problem; }
 const ThermalOptions& ThermalSolver::options() const { return impl_->options; }
 double ThermalSolver::setup_ms() const { return impl_->setup_ms; }
 const LinearSolverStats& ThermalSolver::linear_stats() const { return impl_->solver.stats(); }
+const TemperatureFunctional& ThermalSolver::functional() const { return *impl_->functional; }
 
 ThermalSolution ThermalSolver::solve() { return solve(impl_->problem.robin_field); }
 
@@ -256,17 +260,40 @@ ThermalSolution ThermalSolver::solve(const std::vector<double>& robin_field) {
   out.timings.analysis_ms = stats.analysis_ms;
   out.timings.factorization_ms = stats.factorization_ms;
 
-  Eigen::MatrixXd rhs(a.rows(), m.shortcut ? 1 : 2);
+  // A linear j: state and adjoint in one call (CHOLMOD solves both columns together). Otherwise the
+  // adjoint's right-hand side −j′(u) needs u first: two calls on the same factorisation.
+  const TemperatureFunctional& j = *m.functional;
+  const bool together = m.shortcut || j.linear();
+  Eigen::MatrixXd rhs(a.rows(), together && !m.shortcut ? 2 : 1);
   rhs.col(0) = m.state_rhs;
-  if (!m.shortcut) rhs.col(1) = -m.weights / m.volume;
-  bool warm = m.options.warm_start && m.options.linear.solver == LinearSolver::conjugate_gradient;
-  Eigen::MatrixXd x = m.solver.solve(rhs, warm ? m.previous : Eigen::MatrixXd());
-  if (warm) m.previous = x;
+  if (rhs.cols() == 2) rhs.col(1) = -j.gradient(m.state_rhs);  // j′ of a linear j: any argument
+  const bool warm = m.options.warm_start && m.options.linear.solver == LinearSolver::conjugate_gradient;
+  auto guess = [&](Eigen::Index first, Eigen::Index count) {
+    return warm && m.previous.cols() >= first + count ? Eigen::MatrixXd(m.previous.middleCols(first, count))
+                                                       : Eigen::MatrixXd();
+  };
+  Eigen::MatrixXd x = m.solver.solve(rhs, guess(0, rhs.cols()));
   out.timings.solve_ms = m.solver.stats().solve_ms;
   out.timings.cg_iterations = m.solver.stats().cg_iterations;
   out.u = x.col(0);
-  out.p = m.shortcut ? Eigen::VectorXd(-out.u / m.volume) : Eigen::VectorXd(x.col(1));
+  if (m.shortcut) {
+    out.p = -out.u / m.volume;
+  } else if (together) {
+    out.p = x.col(1);
+  } else {
+    const Eigen::MatrixXd adjoint_rhs = -j.gradient(out.u);
+    const Eigen::MatrixXd p = m.solver.solve(adjoint_rhs, guess(1, 1));
+    out.timings.solve_ms += m.solver.stats().solve_ms;
+    out.timings.cg_iterations = std::max(out.timings.cg_iterations, m.solver.stats().cg_iterations);
+    out.p = p.col(0);
+  }
+  if (warm) {
+    m.previous.resize(out.u.size(), 2);
+    m.previous.col(0) = out.u;
+    m.previous.col(1) = out.p;
+  }
   out.mean_temperature = m.weights.dot(out.u) / m.volume;
+  out.objective = j.value(out.u);
   return out;
 }
 

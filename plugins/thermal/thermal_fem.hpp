@@ -2,17 +2,18 @@
 // P1 finite elements on the tetrahedra of Ω for the thermal model of the paper (4.14, 4.18):
 //
 //   state    −div(γ∇u) = f in Ω,        γ∂u/∂n + κu = g_R on S \ Γ_N,   γ∂u/∂n = g on Γ_N,
-//   adjoint  −div(γ∇p) = −1/|Ω| in Ω,   γ∂p/∂n + κp = 0   on S \ Γ_N,   γ∂p/∂n = 0 on Γ_N,
+//   adjoint  −div(γ∇p) = −j′(u) in Ω,   γ∂p/∂n + κp = 0   on S \ Γ_N,   γ∂p/∂n = 0 on Γ_N,
 //
 // with κ = c(F) a function of the P1 interpolant of a field F on S (for the model: F = d_G, the
 // signed distance to G, and c = h_ε). Both problems have the matrix K_γ + R_κ: one factorisation (or
 // one incomplete factorisation for the conjugate gradient) serves both.
-// The adjoint is that of T = (1/|Ω|)∫_Ω u: dT = pᵀ(dA)u for any change dA of the matrix
-// (shape_derivative.hpp).
+// The adjoint is that of the problem's functional j(u) (objective.hpp; the mean temperature
+// T = (1/|Ω|)∫_Ω u by default): dj = pᵀ(dA)u for any change dA of the matrix (shape_derivative.hpp).
 //
 // Matrices and vectors are indexed by volume vertex; surface fields by surface vertex (= the first
 // VolumeMesh::n_surface_vertices volume vertices); face masks by surface face.
 #include "linear_solver.hpp"
+#include "objective.hpp"
 #include "quadrature.hpp"
 #include "volume_mesh.hpp"
 
@@ -64,14 +65,16 @@ struct ThermalProblem {
   SpatialFunction robin_source{};  ///< g_R on S \ Γ_N (γ∂u/∂n + κu = g_R); empty: 0 (the model's case)
   FaceMask neumann{};              ///< Γ_N, per surface face; empty: Γ_N = ∅
   SpatialFunction neumann_flux{};  ///< g on Γ_N; empty: 0
+  ObjectiveSpec objective{};       ///< the functional j(u) whose adjoint is solved (mean temperature)
 };
 
 struct ThermalOptions {
   LinearSolverOptions linear{};     ///< IC-preconditioned conjugate gradient by default
   TriangleQuadrature quadrature{};  ///< for the Robin and boundary terms (shape_derivative.hpp uses the same)
-  /// When f ≡ 1 (source empty) and there is no boundary source (robin_source and neumann_flux
-  /// empty or Γ_N = ∅), the adjoint right-hand side is −(1/|Ω|) times the state's, so p = −u/|Ω|
-  /// exactly: skip the second solve. Off by default so that the general path is the tested one.
+  /// When j is the mean temperature, f ≡ 1 (source empty) and there is no boundary source
+  /// (robin_source and neumann_flux empty or Γ_N = ∅), the adjoint right-hand side is −(1/|Ω|)
+  /// times the state's, so p = −u/|Ω| exactly: skip the second solve. Off by default so that the
+  /// general path is the tested one.
   bool adjoint_shortcut = false;
   /// Conjugate gradient only: start each solve of ThermalSolver from the previous one's u and p
   /// (the optimisation loop moves G a little per iteration).
@@ -83,7 +86,7 @@ struct ThermalTimings {
   double assembly_ms = 0;       ///< this solve: Robin matrix, K + R
   double analysis_ms = 0;       ///< symbolic analysis (0 when the pattern was reused)
   double factorization_ms = 0;  ///< numeric factorisation
-  double solve_ms = 0;          ///< the state and adjoint solves (one call, two right-hand sides)
+  double solve_ms = 0;          ///< the state and adjoint solves (one call, two right-hand sides, when j is linear)
   int cg_iterations = 0;        ///< conjugate gradient only
 };
 
@@ -92,6 +95,7 @@ struct ThermalSolution {
   Eigen::VectorXd p;              ///< adjoint at every volume vertex
   double volume = 0;              ///< |Ω|
   double mean_temperature = 0;    ///< T = (1/|Ω|)∫_Ω u (exact for the P1 u)
+  double objective = 0;           ///< j(u), the problem's functional (= T for the mean temperature)
   ThermalTimings timings;
 };
 
@@ -119,6 +123,8 @@ class ThermalSolver {
   double setup_ms() const;
   /// The linear solver's statistics after the last solve (fill and flops of the factor, ordering).
   const LinearSolverStats& linear_stats() const;
+  /// The functional j of the problem's objective on this mesh.
+  const TemperatureFunctional& functional() const;
 
  private:
   struct Impl;
