@@ -199,9 +199,10 @@ def thermal_pictures(build):
             run([bodyfit, "-q", "render", str(out / "final.mesh"), "-o", str(images / f"{case}_final_below.png"),
                  "--azimuth", "45", "--elevation", "-35", "--size", "800x600"])
         (fine, _), (coarse, _) = runs["thermal_bracket_fine"], runs["thermal_bracket"]
-        run([bodyfit, "-q", "plot", str(coarse / "objective.csv"), str(fine / "objective.csv"), "-x", "state", "-y", "J",
+        run([bodyfit, "-q", "plot", str(coarse / "history.csv"), str(fine / "history.csv"), "-y", "J", "-y", "J_sharp",
              "--label", "thermal_bracket (l = 0.01, h = 0.07)", "--label", "thermal_bracket_fine (l = 0.05, h = 0.05)",
-             "--title", "J over the accepted states", "-o", str(images / "thermal_J.png")])
+             "--title", "J and J_sharp over the iterations",
+             "--y-label", "J", "-o", str(images / "thermal_J.png")])
     return {case: last for case, (_, last) in runs.items()}
 
 
