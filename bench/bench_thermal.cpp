@@ -1,7 +1,7 @@
 // Thermal shape optimisation: the time of one iteration split by stage, at several mesh sizes.
 //
 //   bench_thermal [--case meshes/cases/thermal_bracket_fine.toml] [--h 0.05,0.035,0.025]
-//                 [--iterations 8] [--solver conjugate_gradient] [-o thermal_timing.csv]
+//                 [--iterations 8] [--solver conjugate_gradient] [--set KEY=VALUE ...] [-o thermal_timing.csv]
 //
 // For each h the case runs with remesh.hmax = h and epsilon = 2h; the medians over the iterations
 // of the driver's stages (velocity = the model's compute: regularisation, plus its solve on the first
@@ -41,16 +41,19 @@ int main(int argc, char** argv) try {
   std::string solver = "conjugate_gradient";
   bench::Arguments args("bench_thermal",
                         "usage: bench_thermal [--case file.toml] [--h 0.05,0.035,0.025] [--iterations 8] [--solver name] "
-                        "[-o thermal_timing.csv]\n"
+                        "[--set KEY=VALUE ...] [-o thermal_timing.csv]\n"
                         "  --case        thermal case (default meshes/cases/thermal_bracket_fine.toml)\n"
                         "  --h           hmax values, one row each (epsilon = 2h)\n"
                         "  --iterations  iterations per size; times are their median (default 8)\n"
                         "  --solver      the model's linear solver (default conjugate_gradient)\n"
+                        "  --set         a case value for every size, as bodyfit run --set (repeatable)\n"
                         "  -o            CSV output (default thermal_timing.csv)\n");
   args.option("--case", case_file);
   args.option("--h", hs);
   args.option("--iterations", iterations);
   args.option("--solver", solver);
+  std::vector<std::string> sets;
+  args.option("--set", [&](const std::string& value) { sets.push_back(value); });
   args.option("-o", csv_file);
   args.parse(argc, argv);
   spdlog::set_level(spdlog::level::warn);
@@ -61,9 +64,12 @@ int main(int argc, char** argv) try {
   fmt::print("{:>7} {:>7} {:>7} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}  (median ms per iteration)\n", "h",
              "faces", "tets", "tetgen", "assembly", "factor", "solve", "regul.", "remesh", "other", "review", "total");
   for (double h : hs) {
-    CaseConfig config = read_case(case_file, {fmt::format("remesh.hmax={}", h), fmt::format("model.epsilon={}", 2 * h),
-                                              fmt::format("time.iterations={}", iterations),
-                                              fmt::format("model.solver=\"{}\"", solver), "model.patience=1000"});
+    std::vector<std::string> overrides = {fmt::format("remesh.hmax={}", h), fmt::format("model.epsilon={}", 2 * h),
+                                          fmt::format("model.epsilon_final={}", 2 * h),
+                                          fmt::format("time.iterations={}", iterations),
+                                          fmt::format("model.solver=\"{}\"", solver), "model.patience=1000"};
+    overrides.insert(overrides.end(), sets.begin(), sets.end());
+    CaseConfig config = read_case(case_file, overrides);
     LoadedModel model = load_model(config.model);
     configure_model(model, config.model_parameters);
     CaseSetup setup = setup_case(config);

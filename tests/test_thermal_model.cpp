@@ -293,3 +293,40 @@ vtu_every = 0
   }
   CHECK((hi - lo) / lo <= 0.01);
 }
+
+TEST_CASE("fixed volume mesh: one tetrahedralisation, the same J on T0, J decreasing, and a resume continues exactly") {
+  bodyfit::test::TempDir dir("thermal_fixed");
+  const std::string case_file = write_case(dir, kSphere);
+  auto remeshed = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "remeshed").string() +
+                                             " --set time.iterations=1");
+  REQUIRE_MESSAGE(remeshed.exit_code == 0, remeshed.output);
+  const std::string fixed = " --set model.volume_mesh=\\\"fixed\\\"";
+  auto full = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "full").string() + fixed);
+  REQUIRE_MESSAGE(full.exit_code == 0, full.output);
+  CHECK(full.output.find("volume mesh: ") != std::string::npos);  // built once, said once
+  // On T⁰, S⁰ is T⁰: d is carried exactly and both modes solve the same problem.
+  const double j_remeshed = std::stod(read_csv(dir / "remeshed" / "objective.csv")[0].at("J"));
+  const double j_fixed = std::stod(read_csv(dir / "full" / "objective.csv")[0].at("J"));
+  CHECK(j_fixed == doctest::Approx(j_remeshed).epsilon(1e-9));
+  const Table rows = read_csv(dir / "full" / "history.csv");
+  REQUIRE(rows.size() >= 5);
+  for (std::size_t i = 2; i < rows.size(); ++i) {
+    CAPTURE(i);
+    if (rows[i].at("forced") != "1") CHECK(std::stod(rows[i].at("J")) < std::stod(rows[i - 1].at("J")));
+    CHECK(rows[i].at("tets") == rows[1].at("tets"));  // one volume mesh
+  }
+  // Interrupted and resumed: S⁰ comes back from the checkpoint, so the same volume mesh and J.
+  auto part = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "part").string() + fixed +
+                                         " --inject-signal 3:INT");
+  CHECK(part.exit_code == 130);
+  auto rest = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "part").string() + fixed + " --resume");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  const Table resumed = read_csv(dir / "part" / "history.csv");
+  REQUIRE(resumed.size() == rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (const char* key : {"area", "J", "step", "tets"}) {
+      CAPTURE(i);
+      CAPTURE(key);
+      CHECK(resumed[i].at(key) == rows[i].at(key));
+    }
+}

@@ -7,17 +7,20 @@
 #include "objective.hpp"
 #include "shape_derivative.hpp"
 #include "smoothing.hpp"
+#include "surface_transfer.hpp"
 #include "thermal_fem.hpp"
 #include "thermal_fixtures.hpp"
 #include "volume_mesh.hpp"
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/projection.hpp>
 #include <bodyfit/surface_fem.hpp>
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -152,7 +155,7 @@ TEST_CASE("the band's derivative carried onto Sigma against finite differences o
   const auto solution = solver.solve();
 
   const InterfaceProjection projection = project_onto_interface(s, kEpsilon + 0.25);
-  const Eigen::VectorXd b = projected_band_load(projection, band_weights(s, d, solution, options));
+  const Eigen::VectorXd b = projected_band_load(projection, band_weights(s, d, solution, options), s.n_vertices());
   std::vector<double> speed(s.n_vertices(), 0.0);
   std::size_t on_sigma = 0;
   for (auto vh : s.vertices()) {
@@ -308,4 +311,33 @@ TEST_CASE("descent: stationary and stalled stops, per stage, and the area target
   al.accept(0.9, 1.001);
   al.set_slope(-0.1);
   CHECK(al.stop_reason().find("stationary") == 0);  // 0.1 % off: within area_tolerance (0.5 %)
+}
+
+TEST_CASE("surface transfer: a linear field carried between two meshes of the unit sphere, to the chords' sagitta") {
+  // f = x + 2y − z sampled on a coarse and a fine sphere: at each fine vertex, the coarse mesh's
+  // field at the closest point differs from f there by at most |∇f| = √6 times the distance between
+  // the meshes: a coarse triangle's sagitta, r_c²/2 ≤ h²/6 for a circumradius r_c ≤ h/√3.
+  const SurfaceMesh coarse = bodyfit::test::unit_sphere(1280), fine = bodyfit::test::unit_sphere(5120);
+  std::vector<double> f(coarse.n_vertices());
+  for (auto v : coarse.vertices()) {
+    const Vec3& p = coarse.point(v);
+    f[std::size_t(v.idx())] = p[0] + 2 * p[1] - p[2];
+  }
+  const ReferenceSurface reference(coarse);
+  const std::vector<double> carried = interpolate(locate(coarse, reference, vertex_points(fine)), f);
+  double worst = 0;
+  for (auto v : fine.vertices()) {
+    const Vec3& p = fine.point(v);
+    worst = std::max(worst, std::abs(carried[std::size_t(v.idx())] - (p[0] + 2 * p[1] - p[2])));
+  }
+  double h = 0;
+  for (auto e : coarse.edges()) h = std::max(h, coarse.calc_edge_length(e));
+  MESSAGE(fmt::format("worst difference {:.3e}, bound sqrt(6) h^2/6 = {:.3e} (h = {:.3f})", worst, std::sqrt(6.0) * h * h / 6, h));
+  CHECK(worst <= std::sqrt(6.0) * h * h / 6);
+  CHECK(worst > 0);
+  // A mesh with deleted elements must be garbage-collected first.
+  SurfaceMesh holed = coarse;
+  holed.delete_face(*holed.faces().begin(), false);
+  const ReferenceSurface holed_reference(holed);
+  CHECK_THROWS_AS(locate(holed, holed_reference, vertex_points(fine)), InputError);
 }

@@ -187,27 +187,32 @@ class InterfaceGrid {
 
 }  // namespace
 
-InterfaceProjection project_onto_interface(const SurfaceMesh& surface, double reach) {
+InterfaceProjection project_onto_interface(const SurfaceMesh& surface, const std::vector<Vec3>& points, double reach) {
   if (!(reach > 0)) throw InputError(fmt::format("interface projection: reach {} (expected > 0)", reach));
   InterfaceProjection p;
-  const std::size_t n = surface.n_vertices();
+  const std::size_t n = points.size();
   p.from.assign(n, -1), p.to.assign(n, -1), p.t.assign(n, 0);
   const InterfaceGrid grid(surface, reach);
   if (grid.empty()) return p;
-  for (auto v : surface.vertices()) {
-    const auto [edge, t] = grid.closest(surface.point(v));
-    if (!edge) continue;
-    const auto k = std::size_t(v.idx());
-    p.from[k] = edge->ia, p.to[k] = edge->ib, p.t[k] = t;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto [edge, t] = grid.closest(points[k]);
+    if (edge) p.from[k] = edge->ia, p.to[k] = edge->ib, p.t[k] = t;
   }
   return p;
 }
 
-Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights) {
+InterfaceProjection project_onto_interface(const SurfaceMesh& surface, double reach) {
+  std::vector<Vec3> points(surface.n_vertices());
+  for (auto v : surface.vertices()) points[std::size_t(v.idx())] = surface.point(v);
+  return project_onto_interface(surface, points, reach);
+}
+
+Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights,
+                                    std::size_t n_vertices) {
   const std::size_t n = projection.from.size();
   if (weights.size() != n)
-    throw InputError(fmt::format("projected band load: {} weights for {} vertices", weights.size(), n));
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(Eigen::Index(n));
+    throw InputError(fmt::format("projected band load: {} weights for {} projected points", weights.size(), n));
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(Eigen::Index(n_vertices));
   for (std::size_t k = 0; k < n; ++k) {
     if (weights[k] == 0) continue;
     if (projection.from[k] < 0)

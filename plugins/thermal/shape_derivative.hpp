@@ -67,6 +67,8 @@ struct InterfaceProjection {
   std::vector<double> t;
 };
 InterfaceProjection project_onto_interface(const SurfaceMesh& surface, double reach);
+/// The same for any points (those of another mesh of S): `from` and `to` index surface's vertices.
+InterfaceProjection project_onto_interface(const SurfaceMesh& surface, const std::vector<Vec3>& points, double reach);
 
 /// W_k = ∫_{S\Γ_N} (dh_ε/dd)(d) u p φ_k with the quadrature of the Robin assembly: the gradient of
 /// the discrete T_ε with respect to d at the vertices, band_derivative(s) = Σ_k W_k s_k. −W_k is the
@@ -79,7 +81,9 @@ std::vector<double> band_weights(const SurfaceMesh& surface, const std::vector<d
 /// pipeline does: it redistances from the moved Σ, so d moves by −v∘π_Σ, not by −v at each point of
 /// the band (the two differ wherever v varies across the band). InputError when W ≠ 0 at a vertex
 /// beyond the projection's reach (the reach must exceed the band's ε).
-Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights);
+/// `n_vertices`: the vertices of the surface whose Σ the projection is onto (the load's size).
+Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights,
+                                    std::size_t n_vertices);
 
 /// v∘π_Σ at the projected vertices, v elsewhere: the normal speed constant along Σ's normals, so
 /// that a step moves each point of Σ by its own v·Δt (a semi-Lagrangian step samples the speed

@@ -233,6 +233,11 @@ const ThermalOptions& ThermalSolver::options() const { return impl_->options; }
 double ThermalSolver::setup_ms() const { return impl_->setup_ms; }
 const LinearSolverStats& ThermalSolver::linear_stats() const { return impl_->solver.stats(); }
 const TemperatureFunctional& ThermalSolver::functional() const { return *impl_->functional; }
+const Eigen::MatrixXd& ThermalSolver::warm_start() const { return impl_->previous; }
+void ThermalSolver::set_warm_start(Eigen::MatrixXd guess) { impl_->previous = std::move(guess); }
+void ThermalSolver::set_robin_coefficient(std::function<double(double)> coefficient) {
+  impl_->problem.robin_coefficient = std::move(coefficient);
+}
 
 ThermalSolution ThermalSolver::solve() { return solve(impl_->problem.robin_field); }
 

@@ -123,6 +123,12 @@ class ThermalSolver {
   double setup_ms() const;
   /// The linear solver's statistics after the last solve (fill and flops of the factor, ordering).
   const LinearSolverStats& linear_stats() const;
+  /// The conjugate gradient's warm start: the last solution [u p] (empty before the first solve),
+  /// and setting it (a resumed run restores it, so that its solves start where the run's did).
+  const Eigen::MatrixXd& warm_start() const;
+  void set_warm_start(Eigen::MatrixXd guess);
+  /// Replace κ's function of the Robin field (a new ε): the next solve uses it.
+  void set_robin_coefficient(std::function<double(double)> coefficient);
   /// The functional j of the problem's objective on this mesh.
   const TemperatureFunctional& functional() const;
 

@@ -13,10 +13,13 @@
 //                  bounds on Δt.
 #include "box_field.hpp"
 #include "descent.hpp"
+#include "fixed_volume.hpp"
 #include "objective.hpp"
 #include "shape_derivative.hpp"
 #include "sharp_problem.hpp"
 #include "smoothing.hpp"
+#include "surface_check.hpp"
+#include "surface_transfer.hpp"
 #include "thermal_fem.hpp"
 #include "volume_mesh.hpp"
 #include "volume_vtu.hpp"
@@ -38,6 +41,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace bodyfit::thermal {
 namespace {
@@ -48,13 +52,16 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 
 /// Everything computed on one state (T^n or a candidate): its volume mesh, u, p and J.
 struct Evaluation {
-  int iteration = -1;  ///< the state it belongs to
-  VolumeMesh volume;
+  int iteration = -1;   ///< the state it belongs to
+  VolumeMesh volume;    ///< its own volume mesh (volume_mesh = "remeshed"; empty with "fixed")
+  const VolumeMesh* solved_on = nullptr;  ///< the volume mesh of `solution`
   ThermalSolution solution;
-  ThermalObjective objective;
+  ThermalObjective objective;  ///< density at the state's vertices
   double interface_length = 0;  ///< |Σ| = ∫_Σ dℓ
   double ms_tetrahedralize = 0;
-  std::vector<double> band_weights;  ///< ∂T_ε/∂d at the vertices (shape_derivative.hpp)
+  std::vector<Vec3> sample_points;   ///< the boundary vertices of the volume mesh
+  std::vector<double> band_weights;  ///< ∂T_ε/∂d at sample_points (shape_derivative.hpp)
+  ScalarField u_surface, p_surface;  ///< u and p at the state's vertices
   ScalarField speed;        ///< the descent speed v computed on this state (empty until then)
   double slope = 0;         ///< M′(v)
   double unit_slope = 0;    ///< M′(v / max |v|): the stationarity measure
@@ -156,6 +163,14 @@ class ThermalModel final : public VelocityModel {
             .fallback(1e-3)
             .at_least(0),
         ParameterDecl::integer("patience", "steps", "see tolerance").fallback(15).within({.min = 1, .max = 1000000}),
+        ParameterDecl::integer("sharp_every", "states", "the sharp problem on every k-th accepted state (J_sharp is "
+                                                        "empty on the others)")
+            .fallback(1)
+            .within({.min = 1, .max = 1000000}),
+        ParameterDecl::choice("volume_mesh", {"fixed", "remeshed"},
+                              "fixed: the smoothed problem on one volume mesh of S⁰ for the whole run, d_G carried to "
+                              "it; remeshed: a new volume mesh of every state")
+            .fallback("remeshed"),
         ParameterDecl::boolean("sharp", "solve the sharp problem (4.12) on every accepted state's volume mesh "
                                         "and report J_sharp (one more solve)")
             .fallback(true),
@@ -238,6 +253,9 @@ class ThermalModel final : public VelocityModel {
     d.patience = int(p.integer("patience"));
     volume_every_ = int(p.integer("volume_every"));
     sharp_ = p.boolean("sharp");
+    fixed_volume_ = p.choice("volume_mesh") == "fixed";
+    sharp_every_ = int(p.integer("sharp_every"));
+    if (!sharp_) p.not_used("sharp_every", "sharp = false");
   }
 
   ModelNeeds needs() const override { return {.may_reject = true, .freeze_velocity = true}; }
@@ -262,9 +280,8 @@ class ThermalModel final : public VelocityModel {
                      {"stationarity", first != 0 ? std::abs(e.unit_slope / first) : 1.0},
                      {"area_rate", e.area_rate},
                      {"ms_regularise", e.ms_direction}};
-    const auto n = std::size_t(e.volume.n_surface_vertices);
-    field.point_fields = {{"temperature", ScalarField(e.solution.u.data(), e.solution.u.data() + n)},
-                          {"adjoint", ScalarField(e.solution.p.data(), e.solution.p.data() + n)},
+    field.point_fields = {{"temperature", e.u_surface},
+                          {"adjoint", e.p_surface},
                           {"shape_gradient", e.objective.density},
                           {"descent_speed", e.speed}};
     return field;
@@ -319,6 +336,7 @@ class ThermalModel final : public VelocityModel {
       // the sharp problem. The candidate is evaluated again with the new ε.
       const double previous = epsilon_;
       epsilon_ = std::max(continuation_factor_ * epsilon_, epsilon_final_);
+      if (fixed_) fixed_->set_robin_coefficient([e = epsilon_](double d) { return h_epsilon(d, e); });
       descent_.options().max_motion = std::min(descent_.options().max_motion, epsilon_ / 2);
       next = evaluate(candidate.mesh(), candidate.distance(), candidate.mesh_size(), candidate.iteration());
       descent_.new_stage(next->objective.j, next->objective.area);
@@ -344,7 +362,7 @@ class ThermalModel final : public VelocityModel {
                  {"noise", descent_.options().noise},
                  {"scatter", scatter_},
                  {"epsilon", epsilon_},
-                 {"tets", double(next->volume.n_tets())},
+                 {"tets", double(next->solved_on->n_tets())},
                  {"ms_tetgen", next->ms_tetrahedralize},
                  {"ms_assembly", t.setup_ms + t.assembly_ms},
                  {"ms_factor", t.analysis_ms + t.factorization_ms},
@@ -383,6 +401,18 @@ class ThermalModel final : public VelocityModel {
     state.set("lengths", std::vector<double>{epsilon_, alpha_length_, d.min_step, d.max_step, d.max_motion, speed_scale_,
                                              epsilon_final_});
     state.set("descent", std::vector<double>{d.noise, d.penalty, descent_.lambda(), descent_.motion(), scatter_});
+    if (fixed_) {  // S⁰, so that a resumed run solves on the same volume mesh
+      std::vector<double> points;
+      for (const Vec3& x : fixed_->points()) points.insert(points.end(), {x[0], x[1], x[2]});
+      std::vector<std::int64_t> faces;
+      for (auto f : fixed_->surface().faces())
+        for (auto v : fixed_->surface().fv_range(f)) faces.push_back(v.idx());
+      state.set("s0_points", points);
+      state.set("s0_faces", faces);
+      // The conjugate gradient's warm start: a resumed run's solves then start where the run's did.
+      const Eigen::MatrixXd& warm = fixed_->solver().warm_start();
+      state.set("warm_start", std::vector<double>(warm.data(), warm.data() + warm.size()));
+    }
   }
 
   void load_state(const ModelState& state) override {
@@ -404,6 +434,23 @@ class ThermalModel final : public VelocityModel {
     DescentOptions& d = descent_.options();
     epsilon_ = lengths[0], alpha_length_ = lengths[1], d.min_step = lengths[2], d.max_step = lengths[3];
     d.max_motion = lengths[4], speed_scale_ = lengths[5], epsilon_final_ = lengths[6];
+    if (state.has("s0_points")) {
+      const auto& points = state.numbers("s0_points");
+      const auto& faces = state.integers("s0_faces");
+      if (points.size() % 3 != 0 || faces.size() % 3 != 0)
+        throw InputError("thermal model state: 's0_points' and 's0_faces' need triples");
+      SurfaceMesh s0;
+      for (std::size_t i = 0; i < points.size(); i += 3) s0.add_vertex(Vec3(points[i], points[i + 1], points[i + 2]));
+      for (std::size_t i = 0; i < faces.size(); i += 3) {
+        for (std::size_t k = 0; k < 3; ++k)
+          if (faces[i + k] < 0 || std::size_t(faces[i + k]) >= s0.n_vertices())
+            throw InputError("thermal model state: 's0_faces' names a vertex S⁰ does not have");
+        s0.add_face(s0.vertex_handle(int(faces[i])), s0.vertex_handle(int(faces[i + 1])),
+                    s0.vertex_handle(int(faces[i + 2])));
+      }
+      resumed_surface_ = std::move(s0);
+      resumed_warm_start_ = state.numbers("warm_start");
+    }
     d.noise = descent[0], d.penalty = descent[1];
     descent_.set_lambda(descent[2]);
     descent_.set_motion(descent[3]);
@@ -427,8 +474,10 @@ class ThermalModel final : public VelocityModel {
     const SurfaceMesh& mesh = context.mesh();
     // The derivative's load: the band's carried onto Σ (projected_band_load: what a step of the
     // pipeline sees), and ℓ_eff times the interface's length load.
-    const InterfaceProjection projection = project_onto_interface(mesh, epsilon_ + 2 * context.mesh_size());
-    const Eigen::VectorXd band = projected_band_load(projection, e.band_weights);
+    const double reach = epsilon_ + 2 * context.mesh_size();
+    const InterfaceProjection onto = project_onto_interface(mesh, e.sample_points, reach);
+    const Eigen::VectorXd band = projected_band_load(onto, e.band_weights, mesh.n_vertices());
+    const InterfaceProjection projection = fixed_volume_ ? project_onto_interface(mesh, reach) : onto;
     const Eigen::VectorXd length = interface_length_load(mesh);
     Eigen::VectorXd rhs = band + descent_.area_weight(e.objective.area) * length;
     Eigen::SparseMatrix<double> system = context.mass_matrix() + (alpha_length_ * alpha_length_) * context.stiffness_matrix();
@@ -539,14 +588,14 @@ class ThermalModel final : public VelocityModel {
                  "{:.4g}, noise {:.3g}{}, dt in [{:.3g}, {:.3g}]",
                  descent_.merit(e.objective.j, e.objective.area), e.objective.j, to_string(objective_.kind),
                  e.objective.area, d.target ? fmt::format(", target {:.6g}", *d.target) : "", context.iteration(),
-                 e.volume.n_tets(), epsilon_, alpha_length_, d.noise, noise_given_ >= 0 ? " (given)" : " (measured)",
+                 e.solved_on->n_tets(), epsilon_, alpha_length_, d.noise, noise_given_ >= 0 ? " (given)" : " (measured)",
                  d.min_step, d.max_step);
   }
 
   /// The relative difference of j between T⁰ and a second mesh of the same G (remeshed everywhere
   /// at the same sizes, its distance recomputed): the scatter a step's remesh and tetrahedralisation
   /// add to j, which the sufficient-decrease test must tolerate (twice it is the default noise).
-  double measure_scatter(const StepContext& context, const Evaluation& e) const {
+  double measure_scatter(const StepContext& context, const Evaluation& e) {
     SurfaceMesh other = context.mesh();
     RemeshOptions options;
     options.hmax = resolution_length(other);  // the sizes a run's remesh keeps
@@ -563,49 +612,110 @@ class ThermalModel final : public VelocityModel {
   }
 
   std::shared_ptr<Evaluation> evaluate(const SurfaceMesh& mesh, const ScalarField& distance, double mesh_size,
-                                       int iteration) const {
+                                       int iteration) {
     auto e = std::make_shared<Evaluation>();
     e->iteration = iteration;
-    auto started = std::chrono::steady_clock::now();
-    TetrahedralizeOptions tetgen = tetgen_;
-    if (volume_factor_ > 0) tetgen.max_volume = volume_factor_ * regular_tet_volume(mesh_size);
-    try {
-      e->volume = tetrahedralize(mesh, tetgen);
-    } catch (const InputError& error) {
-      throw InputError(fmt::format("thermal, iteration {}: {}", iteration, error.what()));
-    }
-    e->ms_tetrahedralize = ms_since(started);
-
-    ThermalProblem problem = base_problem(mesh);
-    problem.robin_field = distance;
     const double epsilon = epsilon_;
-    problem.robin_coefficient = [epsilon](double d) { return h_epsilon(d, epsilon); };
-    const FaceMask neumann = problem.neumann;
     ThermalOptions options;
     options.linear = solver_;
-    try {
-      e->solution = solve_thermal(e->volume, problem, options);
-    } catch (const InputError& error) {
-      throw InputError(fmt::format("thermal, iteration {}: {}", iteration, error.what()));
+    ObjectiveOptions objective{.epsilon = epsilon_, .ell = ell_, .quadrature = options.quadrature};
+    auto failed = [&](const InputError& error) {
+      return InputError(fmt::format("thermal, iteration {}: {}", iteration, error.what()));
+    };
+    if (fixed_volume_) {
+      options.adjoint_shortcut = true;  // p = −u/|Ω| where it holds (thermal_fem.hpp): one solve, not two
+      try {
+        if (!fixed_) build_fixed(resumed_surface_ ? *resumed_surface_ : mesh, mesh_size, options);
+        // The state must still be the skin of a solid (TetGen checked it in "remeshed" mode): a
+        // folded candidate is rejected and the step retried.
+        check_solid_surface(mesh);
+        // d_G carried to S⁰, the smoothed problem there, and u, p, w brought back to T^n.
+        const std::vector<double> d0 = fixed_->carry(mesh, distance);
+        e->solution = fixed_->solve(d0);
+        objective.neumann = fixed_neumann_;
+        e->objective = thermal_objective(fixed_->surface(), d0, e->solution, objective);
+        e->band_weights = band_weights(fixed_->surface(), d0, e->solution, objective);
+      } catch (const InputError& error) {
+        throw failed(error);
+      }
+      e->solved_on = &fixed_->volume();
+      e->sample_points = fixed_->points();
+      const SurfaceLocations at = fixed_->locate_vertices_of(mesh);
+      const auto n0 = std::size_t(fixed_->volume().n_surface_vertices);
+      e->u_surface = interpolate(at, std::vector<double>(e->solution.u.data(), e->solution.u.data() + n0));
+      e->p_surface = interpolate(at, std::vector<double>(e->solution.p.data(), e->solution.p.data() + n0));
+      e->objective.density = interpolate(at, e->objective.density);
+      // |G| from the state's own labels (S⁰'s are G⁰'s).
+      e->objective.area = 0;
+      for (auto f : mesh.faces())
+        if (mesh.inside(f)) e->objective.area += mesh.calc_face_area(f);
+      e->objective.J = e->objective.j + ell_ * e->objective.area;
+    } else {
+      auto started = std::chrono::steady_clock::now();
+      TetrahedralizeOptions tetgen = tetgen_;
+      if (volume_factor_ > 0) tetgen.max_volume = volume_factor_ * regular_tet_volume(mesh_size);
+      ThermalProblem problem = base_problem(mesh);
+      problem.robin_field = distance;
+      problem.robin_coefficient = [epsilon](double d) { return h_epsilon(d, epsilon); };
+      objective.neumann = problem.neumann;
+      try {
+        e->volume = tetrahedralize(mesh, tetgen);
+        e->ms_tetrahedralize = ms_since(started);
+        e->solution = solve_thermal(e->volume, problem, options);
+      } catch (const InputError& error) {
+        throw failed(error);
+      }
+      e->objective = thermal_objective(mesh, distance, e->solution, objective);
+      e->band_weights = band_weights(mesh, distance, e->solution, objective);
+      e->solved_on = &e->volume;
+      e->sample_points = vertex_points(mesh);
+      const auto n = std::size_t(mesh.n_vertices());
+      e->u_surface.assign(e->solution.u.data(), e->solution.u.data() + n);
+      e->p_surface.assign(e->solution.p.data(), e->solution.p.data() + n);
     }
-    ObjectiveOptions objective{.epsilon = epsilon_, .ell = ell_, .quadrature = options.quadrature, .neumann = neumann};
-    e->objective = thermal_objective(mesh, distance, e->solution, objective);
-    e->band_weights = band_weights(mesh, distance, e->solution, objective);
     for (auto edge : mesh.edges())
       if (mesh.interface(edge)) e->interface_length += mesh.calc_edge_length(edge);
     return e;
+  }
+
+  /// The volume mesh of the smoothed problem for the whole run, from S⁰ (T⁰, or the surface a
+  /// checkpoint kept).
+  void build_fixed(const SurfaceMesh& surface, double mesh_size, const ThermalOptions& options) {
+    SurfaceMesh s0 = surface;
+    s0.garbage_collection();
+    TetrahedralizeOptions tetgen = tetgen_;
+    if (volume_factor_ > 0) tetgen.max_volume = volume_factor_ * regular_tet_volume(mesh_size);
+    ThermalProblem problem = base_problem(s0);
+    const double epsilon = epsilon_;
+    problem.robin_coefficient = [epsilon](double d) { return h_epsilon(d, epsilon); };
+    fixed_neumann_ = problem.neumann;
+    fixed_ = std::make_unique<FixedVolume>(std::move(s0), tetgen, std::move(problem), options);
+    if (!resumed_warm_start_.empty()) {
+      const auto n = Eigen::Index(fixed_->volume().n_vertices());
+      if (Eigen::Index(resumed_warm_start_.size()) != 2 * n)
+        throw InputError(fmt::format("thermal model state: 'warm_start' has {} values for 2 × {} volume vertices",
+                                     resumed_warm_start_.size(), n));
+      fixed_->solver().set_warm_start(Eigen::Map<const Eigen::MatrixXd>(resumed_warm_start_.data(), n, 2));
+      resumed_warm_start_.clear();
+    }
+    spdlog::info("thermal: the smoothed problem's volume mesh: {} tetrahedra from {} surface faces, once ({:.0f} ms)",
+                 fixed_->volume().n_tets(), fixed_->surface().n_faces(), fixed_->ms_tetrahedralize());
   }
 
   /// The true objective beside the smoothed one: u = 0 on G's faces of the same volume mesh.
   /// {T_sharp, j_sharp, ms}; NaN when off or when it has no solution.
   std::array<double, 3> sharp_objective(const SurfaceMesh& mesh, const Evaluation& e) const {
     const double nan = std::numeric_limits<double>::quiet_NaN();
-    if (!sharp_) return {nan, nan, 0};
+    if (!sharp_ || e.iteration % sharp_every_ != 0) return {nan, nan, 0};
     FaceMask g(mesh.n_faces(), 0);
     for (auto f : mesh.faces()) g[std::size_t(f.idx())] = mesh.inside(f);
     try {
-      const SharpSolution sharp = solve_sharp(e.volume, base_problem(mesh), g, solver_);
-      return {sharp.mean_temperature, sharp.objective, sharp.ms};
+      // Σ must be in the mesh: the state's own volume mesh (a new one with volume_mesh = "fixed").
+      const auto started = std::chrono::steady_clock::now();
+      VolumeMesh own;
+      if (fixed_volume_) own = tetrahedralize(mesh, tetgen_);
+      const SharpSolution sharp = solve_sharp(fixed_volume_ ? own : e.volume, base_problem(mesh), g, solver_);
+      return {sharp.mean_temperature, sharp.objective, ms_since(started)};
     } catch (const InputError& error) {
       spdlog::warn("thermal, step {}: no sharp J ({})", e.iteration, error.what());
       return {nan, nan, 0};
@@ -649,7 +759,8 @@ class ThermalModel final : public VelocityModel {
   void write_volume(const Evaluation& e, const StepContext& candidate) {
     if (volume_every_ == 0 || candidate.output_dir().empty() || candidate.iteration() % volume_every_ != 0) return;
     const std::string name = fmt::format("volume_{:05d}.vtu", candidate.iteration());
-    write_volume_vtu(e.volume, {{"temperature", &e.solution.u}, {"adjoint", &e.solution.p}}, candidate.output_dir() / name);
+    write_volume_vtu(*e.solved_on, {{"temperature", &e.solution.u}, {"adjoint", &e.solution.p}},
+                     candidate.output_dir() / name);
     if (!volume_pvd_)
       volume_pvd_ = std::make_unique<PvdWriter>(
           PvdWriter::resume(candidate.output_dir() / "volume.pvd", candidate.time() - 0.5 * candidate.dt()));
@@ -667,12 +778,18 @@ class ThermalModel final : public VelocityModel {
   double noise_given_ = -1, min_step_factor_ = 0.0625, max_dt_factor_ = 100;
   int volume_every_ = 0;
   bool sharp_ = true;  ///< J_sharp of every accepted state
+  bool fixed_volume_ = false;  ///< volume_mesh = "fixed"
+  int sharp_every_ = 1;
   // State (saved in checkpoints).
   Descent descent_;          ///< the merit, the records of the accepted states, λ, the step bounds
   double alpha_length_ = 0;  ///< α·h
   double scatter_ = 0;       ///< measure_scatter on T⁰
   double speed_scale_ = 0;   ///< max |v| on T⁰: v is divided by it (or by its own max when larger)
   bool lengths_resolved_ = false;
+  std::unique_ptr<FixedVolume> fixed_;            ///< volume_mesh = "fixed": built at the first state
+  FaceMask fixed_neumann_;                         ///< Γ_N on S⁰
+  std::optional<SurfaceMesh> resumed_surface_;     ///< S⁰ from a checkpoint
+  std::vector<double> resumed_warm_start_;         ///< the solver's warm start from a checkpoint
   // Per step.
   std::shared_ptr<Evaluation> current_;  ///< u, p, J of T^n (the accepted candidate of the last step)
   double slope_ = 0;                     ///< J′(v) of the current descent speed
