@@ -1,6 +1,7 @@
 #include "shape_derivative.hpp"
 
 #include "smoothing.hpp"
+#include "surface_transfer.hpp"
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
@@ -202,9 +203,7 @@ InterfaceProjection project_onto_interface(const SurfaceMesh& surface, const std
 }
 
 InterfaceProjection project_onto_interface(const SurfaceMesh& surface, double reach) {
-  std::vector<Vec3> points(surface.n_vertices());
-  for (auto v : surface.vertices()) points[std::size_t(v.idx())] = surface.point(v);
-  return project_onto_interface(surface, points, reach);
+  return project_onto_interface(surface, vertex_points(surface), reach);
 }
 
 Eigen::VectorXd projected_band_load(const InterfaceProjection& projection, const std::vector<double>& weights,
