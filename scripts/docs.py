@@ -13,7 +13,7 @@
   scripts/docs.py links                           only the links and paths (no build needed)
   scripts/docs.py [--build DIR] measure [ID ...]  print the figures measured now (all, or those named)
   scripts/docs.py [--build DIR] table             write docs/validation/README.md's table of figures
-  scripts/docs.py [--build DIR] pictures          run the thermal cases and write the thermal
+  scripts/docs.py [--build DIR] pictures          run the three thermal cases and write the thermal
                                                   tutorial's pictures (docs/images/thermal_*.png)
 
 docs/validation/figures.tsv holds one figure per row: id, scope (quick: seconds, CI runs it; full: a
@@ -187,20 +187,21 @@ def thermal_pictures(build):
     with tempfile.TemporaryDirectory(prefix="bodyfit_pictures_") as work:
         work = pathlib.Path(work)
         runs = {}
-        for case in ("thermal_bracket", "thermal_bracket_fine"):
+        for case in ("thermal_bracket", "thermal_bracket_fine", "thermal_fandisk"):
             out = work / case
             run([bodyfit, "-q", "run", str(ROOT / "meshes" / "cases" / f"{case}.toml"), "-o", str(out)])
             last = int(run(["bash", "-c", PRELUDE + f"last iteration {out}/history.csv"]).split()[-1])
             runs[case] = (out, last)
-            for state in (0, 10, 30, last):
+            for state in (0, last) if case == "thermal_fandisk" else (0, 10, 30, last):
                 snap = out / f"snap_{state:05d}.png"
                 if snap.exists():
                     (images / f"{case}_n{state:03d}.png").write_bytes(snap.read_bytes())
             run([bodyfit, "-q", "render", str(out / "final.mesh"), "-o", str(images / f"{case}_final_below.png"),
                  "--azimuth", "45", "--elevation", "-35", "--size", "800x600"])
-        (fine, _), (coarse, _) = runs["thermal_bracket_fine"], runs["thermal_bracket"]
-        run([bodyfit, "-q", "plot", str(coarse / "history.csv"), str(fine / "history.csv"), "-y", "J", "-y", "J_sharp",
-             "--label", "thermal_bracket (l = 0.01, h = 0.07)", "--label", "thermal_bracket_fine (l = 0.05, h = 0.05)",
+        (fine, _), (coarse, _), (fandisk, _) = runs["thermal_bracket_fine"], runs["thermal_bracket"], runs["thermal_fandisk"]
+        run([bodyfit, "-q", "plot", str(coarse / "history.csv"), str(fine / "history.csv"), str(fandisk / "history.csv"),
+             "-y", "J", "-y", "J_sharp", "--label", "thermal_bracket (l = 0.01, h = 0.07)",
+             "--label", "thermal_bracket_fine (l = 0.05, h = 0.05)", "--label", "thermal_fandisk (l = 0.01, h = 0.05)",
              "--title", "J and J_sharp over the iterations",
              "--y-label", "J", "-o", str(images / "thermal_J.png")])
     return {case: last for case, (_, last) in runs.items()}

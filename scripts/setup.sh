@@ -31,3 +31,20 @@ if ((${#missing[@]})); then
 else
   echo "setup: all build dependencies present"
 fi
+
+# Public parts the tests run the models on (meshes/public/README.md): extracted from Debian's own
+# packages, not installed (libcgal-demo would pull in CGAL).
+PUBLIC="$(cd "$(dirname "$0")/.." && pwd)/meshes/public"
+if [[ ! -s "$PUBLIC/fandisk.off" ]]; then
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  download() { (cd "$work" && apt-get download -qq libcgal-demo 2> /dev/null); }
+  SUDO=""
+  [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  download || { $SUDO apt-get update -qq && download; } || { echo "setup: cannot download libcgal-demo" >&2; exit 1; }
+  dpkg-deb --fsys-tarfile "$work"/libcgal-demo_*.deb | tar -xO ./usr/share/doc/libcgal-dev/data.tar.gz |
+    tar -xzO data/meshes/fandisk.off > "$work/fandisk.off"
+  [[ -s "$work/fandisk.off" ]] || { echo "setup: fandisk.off not found in libcgal-demo" >&2; exit 1; }
+  mv "$work/fandisk.off" "$PUBLIC/fandisk.off"
+  echo "setup: meshes/public/fandisk.off extracted from libcgal-demo"
+fi

@@ -330,3 +330,25 @@ TEST_CASE("fixed volume mesh: one tetrahedralisation, the same J on T0, J decrea
       CHECK(resumed[i].at(key) == rows[i].at(key));
     }
 }
+
+TEST_CASE("a CAD part not made here (CGAL's fan disk): the shipped case ends normally within its 150 iterations") {
+  // meshes/public/fandisk.off comes from Debian's libcgal-demo (scripts/setup.sh extracts it).
+  const std::filesystem::path part = std::filesystem::path(BODYFIT_SOURCE_DIR) / "meshes" / "public" / "fandisk.off";
+  REQUIRE_MESSAGE(std::filesystem::exists(part), "meshes/public/fandisk.off is missing: run scripts/setup.sh");
+  bodyfit::test::TempDir dir("thermal_fandisk");
+  const std::string case_file = (std::filesystem::path(BODYFIT_SOURCE_DIR) / "meshes" / "cases" / "thermal_fandisk.toml").string();
+  auto run = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "out").string() +
+                                        " --set output.vtu_every=0 --set output.png_every=0");
+  REQUIRE_MESSAGE(run.exit_code == 0, run.output);
+  const bool normal_end = run.output.find("stalled") != std::string::npos || run.output.find("stationary") != std::string::npos;
+  CHECK_MESSAGE(normal_end, run.output.substr(run.output.size() > 2000 ? run.output.size() - 2000 : 0));
+  const Table rows = read_csv(dir / "out" / "history.csv");
+  REQUIRE(rows.size() >= 12);
+  CHECK(rows.size() <= 151);
+  const Table objective = read_csv(dir / "out" / "objective.csv");
+  const double J0 = std::stod(objective.front().at("J")), J = std::stod(rows.back().at("J"));
+  MESSAGE(fmt::format("fandisk: {} iterations, J {:.5f} -> {:.5f}, J_sharp {}", rows.size() - 1, J0, J,
+                      rows.back().at("J_sharp")));
+  CHECK(J < 0.2 * J0);
+  CHECK(std::isfinite(std::stod(rows.back().at("J_sharp"))));
+}

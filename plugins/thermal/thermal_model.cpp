@@ -582,7 +582,7 @@ class ThermalModel final : public VelocityModel {
       d.penalty = area_penalty_factor_ * std::abs(e.objective.j) / (area_target_ * area_target_);
     }
     scatter_ = measure_scatter(context, e);
-    d.noise = noise_given_ >= 0 ? noise_given_ : std::min(1.0, 2 * scatter_);
+    d.noise = noise_given_ >= 0 ? noise_given_ : std::min(d.max_noise, 2 * scatter_);
     descent_.accept(e.objective.j, e.objective.area);
     spdlog::info("thermal: J = {:.8g} (j = {:.8g} [{}], |G| = {:.6g}{}) on T^{}, {} tetrahedra, eps = {:.4g}, alpha = "
                  "{:.4g}, noise {:.3g}{}, dt in [{:.3g}, {:.3g}]",
