@@ -188,6 +188,11 @@ iterations = 2
   auto grows = run("--set model.epsilon_final=0.5");
   CHECK(grows.exit_code == 1);
   CHECK_MESSAGE(grows.output.find("epsilon_final") != std::string::npos, grows.output);
+  // G growing over all of S (ℓ = 0: every new face cools the part): the run says so and ends there.
+  auto all = run("--set model.ell=0 --set model.armijo=1e-4 --set model.noise=0.01 --set region.angle=150 "
+                 "--set time.dt=0.15 --set time.iterations=40");
+  CHECK(all.exit_code == 0);
+  CHECK_MESSAGE(all.output.find("G fills the whole surface") != std::string::npos, all.output);
   // An unknown key, with a suggestion.
   auto typo = run("--set model.epsilom=0.1");
   CHECK(typo.exit_code == 1);
