@@ -194,6 +194,25 @@ TEST_CASE("a fire run interrupted by SIGINT or kill -9 and resumed ends byte-ide
   }
 }
 
+TEST_CASE("SIGTERM and SIGHUP stop a run like Ctrl-C: the iteration is checkpointed, exit 130, and the resume ends "
+          "as the uninterrupted run") {
+  test::TempDir dir("signals");
+  const std::string run_case = "run " + test::source_path("meshes/cases/fire_luxembourg.toml").string() +
+                               " --set time.final_time=3600 --set output.png_every=0 -o ";
+  auto full = test::run_bodyfit(run_case + (dir / "full").string());
+  REQUIRE_MESSAGE(full.exit_code == 0, full.output);
+  for (const std::string signal : {"TERM", "HUP"}) {
+    CAPTURE(signal);
+    const auto out = dir / signal;
+    auto first = test::run_bodyfit(run_case + out.string() + " --inject-signal 3:" + signal);
+    CHECK(first.exit_code == 130);
+    CHECK(load_checkpoint(out / "checkpoint.bin").run.iteration == 3);
+    auto rest = test::run_bodyfit(run_case + out.string() + " --resume");
+    REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+    CHECK(test::read_file(out / "final.mesh") == test::read_file(dir / "full" / "final.mesh"));
+  }
+}
+
 TEST_CASE("a model returning NaN velocities is an error naming the model and the iteration, not a wrong region") {
   CHECK_THROWS_WITH_AS(run("nan_at_vertex = 17"),
                        doctest::Contains("model 'testlifecycle' failed in compute at iteration 0: non-finite velocity "

@@ -11,6 +11,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -424,4 +425,53 @@ TEST_CASE("the run's own files: names, temporaries, per-state files past a check
   CHECK(names_in(dir.path()) == std::vector<std::string>{"history.csv", "mine.vtu", "step_00001.vtu"});
   remove_run_outputs(dir.path());
   CHECK(names_in(dir.path()) == std::vector<std::string>{"mine.vtu"});
+}
+
+TEST_CASE("a model stuck in compute: the first signal waits for it, a second one ends the run at once, the "
+          "checkpoint intact and resumable") {
+  test::TempDir dir("faults_stuck");
+  const fs::path hang = dir / "hang";
+  std::ofstream(hang) << "stuck while this file exists\n";
+  const fs::path file = dir / "case.toml";
+  std::ofstream(file) << fmt::format(R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.1
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.3]
+[model]
+name = "testlifecycle"
+speed = 0.5
+hang_file = "{}"
+[time]
+dt = 0.05
+iterations = 4
+[remesh]
+hmax = 0.1
+[output]
+vtu_every = 0
+png_every = 0
+)", hang.string());
+  ::setenv("BODYFIT_PLUGIN_PATH", BODYFIT_TEST_PLUGIN_DIR, 1);
+  const fs::path out = dir / "out", status = dir / "status";
+  // The run stalls in the compute of iteration 1 (after T^0's row is written); SIGTERM there is
+  // honoured only after the iteration, which never ends; a second SIGTERM ends the process.
+  const std::string script = fmt::format(
+      "'{}' run '{}' -o '{}' > '{}log' 2>&1 & pid=$!; "
+      "for i in $(seq 600); do [ -s '{}/history.csv' ] && break; sleep 0.1; done; sleep 0.5; "
+      "kill -TERM $pid; sleep 0.5; kill -TERM $pid; wait $pid; echo $? > '{}'",
+      BODYFIT_EXE, file.string(), out.string(), (dir / "").string(), out.string(), status.string());
+  std::ofstream(dir / "signal.sh") << script << "\n";
+  REQUIRE(std::system(("bash '" + (dir / "signal.sh").string() + "'").c_str()) == 0);
+  CHECK(test::read_file(status) == "130\n");
+  CHECK(load_checkpoint(out / "checkpoint.bin").run.iteration == 0);
+  // Unstuck (the hang file, one of the case's inputs, is gone: --force), the resume continues from
+  // T^0 and finishes.
+  fs::remove(hang);
+  auto rest = test::run_bodyfit("run " + file.string() + " -o " + out.string() + " --resume --force");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  CHECK(fs::exists(out / "final.mesh"));
 }

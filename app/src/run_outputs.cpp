@@ -32,12 +32,17 @@ InjectedSignal parse_injected_signal(const std::string& text) {
   } catch (const std::exception&) {
     s.iteration = -1;
   }
-  if (parts.size() >= 2) s.signal = parts[1] == "INT" ? SIGINT : parts[1] == "KILL" ? SIGKILL : 0;
+  if (parts.size() >= 2)
+    s.signal = parts[1] == "INT"    ? SIGINT
+               : parts[1] == "TERM" ? SIGTERM
+               : parts[1] == "HUP"  ? SIGHUP
+               : parts[1] == "KILL" ? SIGKILL
+                                    : 0;
   if (parts.size() == 3 && parts[2] == "scheduled") s.force_checkpoint = false;
   else if (parts.size() != 2) s.signal = 0;
   if (s.iteration < 0 || s.signal == 0)
-    throw InputError(fmt::format("--inject-signal {}: expected ITERATION:INT or ITERATION:KILL, optionally followed "
-                                 "by :scheduled",
+    throw InputError(fmt::format("--inject-signal {}: expected ITERATION:SIGNAL (INT, TERM, HUP or KILL), optionally "
+                                 "followed by :scheduled",
                                  text));
   return s;
 }

@@ -19,6 +19,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <unistd.h>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -30,7 +31,14 @@ namespace fs = std::filesystem;
 using namespace bodyfit;
 
 std::atomic<bool> g_interrupted{false};
-extern "C" void on_sigint(int) { g_interrupted.store(true); }
+// SIGINT (Ctrl-C), SIGTERM (what SLURM, systemd and `docker stop` send) and SIGHUP (a closed
+// terminal): the current iteration finishes and is checkpointed, then the run exits with 130. A
+// second signal, while the first is being honoured (a model stuck in compute), ends the process at
+// once: the checkpoint on disk is the last completed one (files are written to a temporary and
+// renamed, and a resume removes the temporaries).
+extern "C" void on_run_signal(int) {
+  if (g_interrupted.exchange(true)) _exit(130);
+}
 
 struct RunArguments {
   std::string case_file;
@@ -105,7 +113,7 @@ void prepare_directory(const fs::path& outdir, const RunArguments& args, int res
 int run_case(const RunArguments& args) {
   // From the start (a Ctrl-C during setup stops before the first iteration), and even when the
   // shell started us with SIGINT ignored (background jobs).
-  std::signal(SIGINT, on_sigint);
+  for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, on_run_signal);
   const InjectedSignal inject = parse_injected_signal(args.inject_signal);
   if (!args.inject_fault.empty()) arm_fault(args.inject_fault);
   if (!args.inject_io_error.empty()) arm_fault(args.inject_io_error, FaultKind::IoError);

@@ -1,12 +1,17 @@
 // A test model for the step lifecycle: constant normal speed, and on request it rejects the first
 // candidate of every k-th step, stops the run at an iteration, and drives Δt (grown by a factor
 // after every accepted step: state a resume must restore). It also checks that T^n is restored
-// exactly before a retry (the arrays seen by end_step on attempt 0 and on the retries).
+// exactly before a retry (the arrays seen by end_step on attempt 0 and on the retries). A model stuck in
+// compute: with `hang_file`, compute() waits while that file exists (a signal's escape is tested
+// on it).
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/velocity_model.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <thread>
 
 namespace {
 
@@ -38,7 +43,8 @@ class LifecycleModel final : public VelocityModel {
             ParameterDecl::integer("stop_at", "", "stop the run at this iteration (-1: never)").fallback(-1),
             ParameterDecl::number("grow_dt", "", "next Δt = this × Δt (0: the driver's)").fallback(0.0).at_least(0),
             ParameterDecl::boolean("freeze", "needs().freeze_velocity").fallback(false),
-            ParameterDecl::integer("nan_at_vertex", "", "a NaN speed at this vertex (-1: none)").fallback(-1).at_least(-1)};
+            ParameterDecl::integer("nan_at_vertex", "", "a NaN speed at this vertex (-1: none)").fallback(-1).at_least(-1),
+            ParameterDecl::string("hang_file", "compute() waits while this file exists (\"\": never)").fallback("")};
   }
   void configure(Parameters& p) override {
     speed_ = p.number("speed");
@@ -47,11 +53,14 @@ class LifecycleModel final : public VelocityModel {
     grow_dt_ = p.number("grow_dt");
     freeze_ = p.boolean("freeze");
     nan_at_ = p.integer("nan_at_vertex");
+    hang_file_ = p.string("hang_file");
   }
   ModelNeeds needs() const override { return {.may_reject = reject_every_ > 0, .freeze_velocity = freeze_}; }
 
   VelocityField compute(const StepContext& context) override {
     ++computes_;
+    while (!hang_file_.empty() && context.iteration() > 0 && std::filesystem::exists(hang_file_))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // stuck: only a second signal ends it
     auto field = VelocityField::normal(ScalarField(context.mesh().n_vertices(), speed_));
     if (nan_at_ >= 0 && std::size_t(nan_at_) < field.normal_speed.size())  // a faulty model
       field.normal_speed[std::size_t(nan_at_)] = std::nan("");
@@ -99,6 +108,7 @@ class LifecycleModel final : public VelocityModel {
   double grow_dt_ = 0;
   bool freeze_ = false;
   std::int64_t nan_at_ = -1;
+  std::string hang_file_;
   std::int64_t accepted_ = 0;
   std::int64_t computes_ = 0;
   int restore_mismatches_ = 0;
