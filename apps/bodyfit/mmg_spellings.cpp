@@ -65,7 +65,19 @@ Translation translate_mmg_spellings(std::vector<std::string> arguments, const st
   out.assign(arguments.begin(), command_at == arguments.end() ? arguments.end() : command_at + 1);
   if (command_at == arguments.end()) return t;
   for (auto it = command_at + 1; it != arguments.end(); ++it) {
-    const std::string& a = *it;
+    std::string a = *it;
+    // MMG's -hmax=0.1: the option and its value (CLI11 would read -h, help, and exit 0).
+    if (const auto eq = a.find('='); a.size() > 2 && a[0] == '-' && a[1] != '-' && eq != std::string::npos) {
+      const std::string name = a.substr(0, eq);
+      if (name == "-hmin" || name == "-hmax" || name == "-hausd" || name == "-hgrad") {
+        if (!discretize && !remesh)
+          return refuse(fmt::format("{} is MMG's spelling, for `bodyfit discretize` and `bodyfit remesh`; `bodyfit {}` "
+                                    "has no such option (see bodyfit {} --help)",
+                                    name, command, command));
+        out.push_back("-" + a);  // --hmax=0.1
+        continue;
+      }
+    }
     const bool sizes = a == "-hmin" || a == "-hmax" || a == "-hausd" || a == "-hgrad";
     const bool mmg = sizes || a == "-in" || a == "-out" || a == "-sol" || a == "-ls" || a == "-nr";
     if (mmg && !discretize && !remesh)
@@ -104,6 +116,11 @@ Translation translate_mmg_spellings(std::vector<std::string> arguments, const st
                                      [&](const Unsupported& x) { return a == x.spelling; });
                u != std::end(kUnsupported) && (discretize || remesh)) {
       return refuse(fmt::format("{} (an MMG option) is not supported by `bodyfit {}`: {}", a, command, u->advice));
+    } else if (a.size() > 2 && a[0] == '-' && a[1] != '-' && !is_number(a, nullptr)) {
+      // A single dash before a word is not an option of bodyfit's (its long options take two): CLI11
+      // would read it as a group of one-letter flags, -help… among them.
+      return refuse(fmt::format("{}: unknown option (bodyfit's long options take two dashes: -{}; see bodyfit {} --help)",
+                                a, a, command));
     } else {
       out.push_back(a);
     }
