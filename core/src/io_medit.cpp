@@ -114,7 +114,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
         p[1] = in.real("the y coordinate");
         if (header.dimension == 3) p[2] = in.real("the z coordinate");
         r.points.push_back(p);
-        r.vertex_refs.push_back(int(in.integer("the vertex ref")));
+        r.vertex_refs.push_back(in.reference("the vertex ref"));
       }
     } else if (word == "Triangles") {
       auto n = count_of("Triangles");
@@ -128,7 +128,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
         std::array<std::int64_t, 3> t{};
         for (auto& v : t) v = zero_based(in.integer("a vertex index"));
         r.triangles.push_back(t);
-        r.triangle_refs.push_back(int(in.integer("the triangle ref")));
+        r.triangle_refs.push_back(in.reference("the triangle ref"));
       }
     } else if (word == "Edges") {
       auto n = count_of("Edges");
@@ -141,7 +141,7 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
         std::array<std::int64_t, 2> e{};
         for (auto& v : e) v = zero_based(in.integer("a vertex index"));
         r.edges.push_back(e);
-        r.edge_refs.push_back(int(in.integer("the edge ref")));
+        r.edge_refs.push_back(in.reference("the edge ref"));
       }
     } else if (word == "Corners") {
       index_list("Corners", r.corners, r.corner_at);
@@ -182,6 +182,14 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   auto read_index = [&]() -> std::int64_t {
     return format.int64_integers() ? in.get_unchecked<std::int64_t>() : std::int64_t(in.get_unchecked<std::int32_t>());
   };
+  // A ref of a 64-bit file must still fit an int.
+  auto read_ref = [&](const char* what) -> int {
+    const std::int64_t value = read_index();
+    if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max())
+      throw file_error(file, fmt::format("{} {} does not fit in 32 bits (refs are from {} to {})", what, value,
+                                         std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+    return int(value);
+  };
   auto read_real = [&]() -> double {
     return format.float32() ? double(in.get_unchecked<float>()) : in.get_unchecked<double>();
   };
@@ -210,7 +218,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
           Vec3 p(0, 0, 0);
           for (int k = 0; k < dimension; ++k) p[k] = read_real();
           r.points[std::size_t(i)] = p;
-          r.vertex_refs[std::size_t(i)] = int(read_index());
+          r.vertex_refs[std::size_t(i)] = read_ref("a vertex ref");
         }
         break;
       }
@@ -223,7 +231,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         for (std::int64_t i = 0; i < n; ++i) {
           auto& t = r.triangles[std::size_t(i)];
           for (auto& v : t) v = zero_based(read_index());
-          r.triangle_refs[std::size_t(i)] = int(read_index());
+          r.triangle_refs[std::size_t(i)] = read_ref("a triangle ref");
         }
         break;
       }
@@ -236,7 +244,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         for (std::int64_t i = 0; i < n; ++i) {
           auto& e = r.edges[std::size_t(i)];
           for (auto& v : e) v = zero_based(read_index());
-          r.edge_refs[std::size_t(i)] = int(read_index());
+          r.edge_refs[std::size_t(i)] = read_ref("an edge ref");
         }
         break;
       }

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -142,6 +143,15 @@ class TextScanner {
     if (ec != std::errc() || (ptr < end_ && !is_space(*ptr))) throw malformed(start, what, "an integer");
     p_ = ptr;
     return value;
+  }
+
+  /// An integer that must fit an int (the refs of vertices, edges and faces).
+  int reference(const char* what) {
+    const std::int64_t value = integer(what);
+    if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max())
+      throw error(fmt::format("{} {} does not fit in 32 bits (refs are from {} to {})", what, value,
+                              std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+    return int(value);
   }
 
   double real(const char* what) {
