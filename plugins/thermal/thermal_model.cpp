@@ -603,7 +603,13 @@ class ThermalModel final : public VelocityModel {
     options.incremental = false;
     remesh(other, options);
     const ScalarField distance = signed_distance_to_region(other);
-    const auto second = evaluate(other, distance, context.mesh_size(), context.iteration());
+    std::shared_ptr<Evaluation> second;
+    try {
+      second = evaluate(other, distance, context.mesh_size(), context.iteration());
+    } catch (const InputError& error) {  // a second mesh TetGen or the surface check refuses
+      spdlog::warn("thermal: no second mesh of G^0 to measure the noise of J on ({}); the steps' retries will", error.what());
+      return 0;
+    }
     const double scatter = std::abs(second->objective.j - e.objective.j) / std::abs(e.objective.j);
     spdlog::info("thermal: j = {:.8g} on T^0 and {:.8g} on a second mesh of G^0 ({} and {} faces): relative scatter "
                  "{:.3g}",
