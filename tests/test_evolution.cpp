@@ -1,14 +1,17 @@
 // The evolution loop against exact solutions: the paper's growing cap on the unit sphere (§4.2),
 // a disk growing on a plane, an interface meeting the boundary, the merge of two caps, and
-// `bodyfit run` (outputs, --resume gives the same final mesh as an uninterrupted run).
+// `bodyfit run` (outputs, --resume gives the same final mesh as an uninterrupted run), and a model's
+// nuclei (new components of G where no front is).
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
+#include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
 #include "test_support.hpp"
+#include "thermal_fixtures.hpp"
 
 #include <doctest/doctest.h>
 
@@ -214,4 +217,108 @@ TEST_CASE("[time] max_cfl: a long step is made of sub-steps on the same mesh, an
   // Without the cap, one pass per step.
   Outcome plain = run(kPlane, {"time.cfl=3.0"});
   CHECK(plain.result.records.front().substeps == 1);
+}
+
+namespace {
+
+/// G stands still (v = 0) and the model asks for a disk of `radius` around the vertex closest to
+/// `centre` at the first step's first attempt.
+class Nucleating final : public VelocityModel {
+ public:
+  Nucleating(Vec3 centre, double radius) : centre_(centre), radius_(radius) {}
+  std::string_view name() const override { return "nucleating"; }
+  void configure(Parameters&) override {}
+  VelocityField compute(const StepContext& context) override {
+    return VelocityField::normal(ScalarField(context.mesh().n_vertices(), 0.0));
+  }
+  std::vector<Nucleus> nuclei(const StepContext& state, int attempt) override {
+    if (state.iteration() != 0 || attempt != 0) return {};
+    const SurfaceMesh& mesh = state.mesh();
+    int closest = 0;
+    for (auto v : mesh.vertices())
+      if ((mesh.point(v) - centre_).norm() < (mesh.point(VertexHandle(closest)) - centre_).norm()) closest = v.idx();
+    at_ = mesh.point(VertexHandle(closest));
+    return {Nucleus{vertex_out_of_range ? int(mesh.n_vertices()) : closest, radius_}};
+  }
+  bool vertex_out_of_range = false;
+  Vec3 at_{};
+
+ private:
+  Vec3 centre_;
+  double radius_;
+};
+
+}  // namespace
+
+TEST_CASE("a model's nuclei: a disk where no front is joins G, kept by drop_detached; none from an ABI 3.0 plugin") {
+  CaseConfig config = parse_case(toml::parse(kPlane));
+  const double rho = 0.2, r0 = 0.3;
+  for (bool drop_detached : {false, true}) {
+    CAPTURE(drop_detached);
+    CaseSetup setup = setup_case(config);
+    setup.options.max_iterations = 1;
+    setup.options.discretize.drop_detached = drop_detached;
+    Nucleating model({0.6, 0.1, 0}, rho);
+    const EvolutionResult result = evolve(setup.mesh, model, setup.options, {}, EvolutionHooks::quiet());
+    REQUIRE(result.records.size() == 1);
+    CHECK(result.records.back().components == 2);
+    // The two disks' areas, to the polygon's chords (h = 0.05: a relative deficit ~ h²/(3r²) < 1 %).
+    CHECK(result.records.back().area == doctest::Approx(kPi * (r0 * r0 + rho * rho)).epsilon(0.01));
+    // The new component is the disk around the vertex the model named.
+    double farthest = 0, nearest = 1e9;
+    for (auto e : setup.mesh.edges())
+      if (setup.mesh.interface(e)) {
+        const Vec3 p = setup.mesh.point(setup.mesh.to_vertex_handle(setup.mesh.halfedge_handle(e, 0)));
+        if ((p - model.at_).norm() < 0.27) {  // the first disk is 0.31 away
+          farthest = std::max(farthest, (p - model.at_).norm());
+          nearest = std::min(nearest, (p - model.at_).norm());
+        }
+      }
+    CHECK(nearest == doctest::Approx(rho).epsilon(0.01));
+    CHECK(farthest == doctest::Approx(rho).epsilon(0.01));
+  }
+  SUBCASE("a plugin built for ABI 3.0 has no nuclei: G stays one disk") {
+    CaseSetup setup = setup_case(config);
+    setup.options.max_iterations = 1;
+    Nucleating model({0.6, 0.1, 0}, rho);
+    GuardedModel guarded(model, 0, 3u << 16);
+    const EvolutionResult result = evolve(setup.mesh, guarded, setup.options, {}, EvolutionHooks::quiet());
+    CHECK(result.records.back().components == 1);
+  }
+  SUBCASE("a nucleus at a vertex T^n does not have is the model's failure") {
+    CaseSetup setup = setup_case(config);
+    setup.options.max_iterations = 1;
+    Nucleating model({0.6, 0.1, 0}, rho);
+    model.vertex_out_of_range = true;
+    GuardedModel guarded(model, 0);
+    CHECK_THROWS_WITH_AS(evolve(setup.mesh, guarded, setup.options, {}, EvolutionHooks::quiet()),
+                         doctest::Contains("failed in nuclei at iteration 0: a nucleus at vertex"), PluginError);
+  }
+}
+
+TEST_CASE("a nucleus's disk stays on its sheet of S: a thin wall's other face, nearer than the radius, is not in it") {
+  // A slab 2 × 2 × 0.1 gridded 20 to a side: the faces z = 0 and z = 0.1 are 0.1 apart.
+  const SurfaceMesh slab = test::make_box(20, {0, 0, 0}, {2, 2, 0.1});
+  int centre = 0;
+  for (auto v : slab.vertices())
+    if ((slab.point(v) - Vec3(1, 1, 0.1)).norm() < 1e-9) centre = v.idx();
+  const double rho = 0.3;
+  const ScalarField psi = nucleus_level_set(slab, {centre, rho});
+  int inside = 0;
+  for (auto v : slab.vertices()) {
+    const Vec3& p = slab.point(v);
+    if (p[2] < 0.05) {
+      CHECK(psi[std::size_t(v.idx())] > 0);  // the bottom face, 0.1 below the centre
+    } else if (p[2] > 0.099) {
+      const double r = std::hypot(p[0] - 1, p[1] - 1);
+      if (r < rho - 1e-9) {
+        CHECK(psi[std::size_t(v.idx())] == doctest::Approx(r - rho));
+        ++inside;
+      }
+      if (r > rho + 1e-9) CHECK(psi[std::size_t(v.idx())] > 0);
+    }
+  }
+  CHECK(inside == 25);  // the grid points of spacing 0.1 strictly within 0.3 of the centre
+  CHECK_THROWS_AS(nucleus_level_set(slab, {int(slab.n_vertices()), rho}), InputError);
+  CHECK_THROWS_AS(nucleus_level_set(slab, {centre, std::nan("")}), InputError);
 }

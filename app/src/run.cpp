@@ -20,7 +20,7 @@ Run::Run(CaseConfig config, const std::filesystem::path& output_dir)
 }
 
 GuardedModel& Run::guarded(int start) {
-  if (!guarded_) guarded_.emplace(model_.model(), start);
+  if (!guarded_) guarded_.emplace(model_.model(), start, model_.abi());
   return *guarded_;
 }
 

@@ -97,6 +97,8 @@ std::vector<int> within(const ScalarField& phi, double width) {
 /// What step 2 (d, V, advection, sub-steps) hands to the cut.
 struct LevelSetStep {
   ScalarField phi_next;           ///< φ^{n+1} on T^n
+  /// d^n with the step's nuclei added (VelocityModel::nuclei), for drop_detached; empty: none.
+  ScalarField nucleated;
   double done = 0;                ///< time advanced (the step, or less when G vanished within it)
   int substeps = 0;
   StageTimes ms;
@@ -163,6 +165,7 @@ class Evolution {
     for (int attempt = 0;; ++attempt) {
       const double dt = step / std::ldexp(1.0, attempt);
       LevelSetStep level_set = level_set_step(dt, attempt);  // 2.
+      add_nuclei(level_set, attempt);
       cut_and_remesh(level_set);                             // 3. T^n is now the candidate
       Review review = review_or_restore(level_set, attempt, kept_mesh, kept_distance);  // 4.
       if (review.accepted()) {                               // 5.
@@ -398,13 +401,34 @@ class Evolution {
 
   double cfl_length() const { return options_.cfl_length > 0 ? options_.cfl_length : mean_edge_length(mesh_); }
 
+  /// The model's new components of G: φ^{n+1} ← min(φ^{n+1}, ψ) on T^n, and the same for d^n where
+  /// drop_detached looks for what G^{n+1} grew from (a nucleus is not a detached part).
+  void add_nuclei(LevelSetStep& step, int attempt) {
+    Stopwatch clock;
+    const StepContext context = context_for(mesh_, distance_, n_, t_, step.done);
+    const std::vector<Nucleus> nuclei = model_.nuclei(context, attempt);
+    if (nuclei.empty()) return;
+    step.nucleated = distance_;
+    for (const Nucleus& nucleus : nuclei) {
+      const ScalarField psi = nucleus_level_set(mesh_, nucleus);
+      for (std::size_t v = 0; v < psi.size(); ++v) {
+        step.phi_next[v] = std::min(step.phi_next[v], psi[v]);
+        step.nucleated[v] = std::min(step.nucleated[v], psi[v]);
+      }
+    }
+    if (hooks_.log)
+      spdlog::info("n={} t={:.5g}: model '{}' adds {} new component(s) of G", n_, t_, model_.name(), nuclei.size());
+    step.ms.velocity += clock.lap_ms();
+  }
+
   // ---- 3. cut and remesh: the candidate T^{n+1} -------------------------------------------------
   void cut_and_remesh(LevelSetStep& step) {
     candidate_ = true;  // from here on the mesh is no longer T^n
     solver_.reset();  // T^n's, and memory the remesh can use
     Stopwatch clock;
     DiscretizeOptions cut = options_.discretize;
-    if (cut.drop_detached) cut.grown_from = distance_;  // d^n on T^n: G^{n+1} grows from G^n
+    if (cut.drop_detached)  // d^n on T^n: G^{n+1} grows from G^n (and the step's nuclei)
+      cut.grown_from = step.nucleated.empty() ? std::span<const double>(distance_) : std::span<const double>(step.nucleated);
     const DiscretizeReport report = discretize(mesh_, step.phi_next, cut);
     if (report.removed_detached > 0)
       spdlog::debug("n={}: {} part(s) of G detached from G^n given to the outside", n_ + 1, report.removed_detached);

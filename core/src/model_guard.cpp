@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstring>
+#include <stdexcept>
 #include <vector>
 
 #include <unistd.h>
@@ -105,8 +107,8 @@ PluginCall::PluginCall(const char* stage, int iteration) {
 
 PluginCall::~PluginCall() { g_stage.store(nullptr); }
 
-GuardedModel::GuardedModel(VelocityModel& model, int iteration)
-    : model_(model), name_(model.name()), iteration_(iteration), step_(iteration) {}
+GuardedModel::GuardedModel(VelocityModel& model, int iteration, std::uint32_t abi)
+    : model_(model), name_(model.name()), iteration_(iteration), step_(iteration), abi_(abi) {}
 
 template <class Call>
 auto GuardedModel::guarded(const char* stage, int iteration, Call&& call) const -> decltype(call()) {
@@ -156,6 +158,20 @@ void GuardedModel::load_state(const ModelState& state) {
 
 void GuardedModel::finish(const StepContext& final_state, ModelOutputs& outputs) {
   guarded("finish", iteration_, [&] { model_.finish(final_state, outputs); });
+}
+
+std::vector<Nucleus> GuardedModel::nuclei(const StepContext& state, int attempt) {
+  if (!plugin_has(abi_, kAbiNuclei)) return {};
+  return guarded("nuclei", step_, [&] {
+    std::vector<Nucleus> nuclei = model_.nuclei(state, attempt);
+    for (const Nucleus& nucleus : nuclei)
+      if (nucleus.vertex < 0 || std::size_t(nucleus.vertex) >= state.mesh().n_vertices() || !(nucleus.radius > 0) ||
+          !std::isfinite(nucleus.radius))
+        throw std::runtime_error(fmt::format("a nucleus at vertex {} of radius {} (T^n has {} vertices; the radius must "
+                                             "be positive and finite)",
+                                             nucleus.vertex, nucleus.radius, state.mesh().n_vertices()));
+    return nuclei;
+  });
 }
 
 }  // namespace bodyfit

@@ -40,8 +40,9 @@ class PluginCall {
 /// A configured model (configure_model: its InputError on a bad parameter is the user's input).
 class GuardedModel final : public VelocityModel {
  public:
-  /// `iteration`: where the run starts (the state load_state restores on --resume).
-  GuardedModel(VelocityModel& model, int iteration);
+  /// `iteration`: where the run starts (the state load_state restores on --resume); `abi`: the
+  /// plugin's (LoadedModel::abi), so that a member its ABI does not have is never called.
+  GuardedModel(VelocityModel& model, int iteration, std::uint32_t abi = kPluginAbi);
 
   std::string_view name() const override { return name_; }
   std::string_view version() const override { return model_.version(); }
@@ -57,6 +58,8 @@ class GuardedModel final : public VelocityModel {
   void save_state(ModelState& state) const override;
   void load_state(const ModelState& state) override;
   void finish(const StepContext& final_state, ModelOutputs& outputs) override;
+  /// The model's nuclei (none from a plugin built before ABI 3.1), each checked against T^n.
+  std::vector<Nucleus> nuclei(const StepContext& state, int attempt) override;
 
  private:
   template <class Call>
@@ -66,6 +69,7 @@ class GuardedModel final : public VelocityModel {
   std::string name_;
   int iteration_;  ///< the last iteration seen (the start, compute's, review's)
   int step_;       ///< the iteration of the last compute (end_step's)
+  std::uint32_t abi_;
 };
 
 }  // namespace bodyfit

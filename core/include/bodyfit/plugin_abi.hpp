@@ -18,7 +18,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 3;
-inline constexpr std::uint32_t kPluginAbiMinor = 0;
+inline constexpr std::uint32_t kPluginAbiMinor = 1;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// A feature of the plugin interface and the ABI version that brought it.
@@ -35,6 +35,10 @@ inline constexpr AbiFeature kAbiDeclaredParameters{3, 0, "declared parameters"};
 inline constexpr AbiFeature kAbiDeclaredOutputs{3, 0, "declared outputs"};
 /// The surface's source and coordinate system before configure (VelocityModel::set_surface).
 inline constexpr AbiFeature kAbiSurfaceSource{3, 0, "surface source"};
+
+// The features of ABI 3.1.
+/// New components of G named by the model (VelocityModel::nuclei).
+inline constexpr AbiFeature kAbiNuclei{3, 1, "nuclei"};
 
 /// Whether a plugin built for `abi` has `feature`.
 constexpr bool plugin_has(std::uint32_t abi, AbiFeature feature) {

@@ -12,6 +12,7 @@
 // The life of one step n (docs/guide/writing_models.md has the whole picture):
 //   compute(T^n)            V^n (once per CFL sub-step, or once per step with needs().freeze_velocity)
 //   end_step(φ^{n+1} on T^n) after each advection, before the cut (optional)
+//   nuclei(T^n)             new components of G the step creates, added to φ^{n+1} before the cut (optional)
 //   review(candidate T^{n+1}) accept / reject (the driver restores T^n and retries with Δt/2; only
 //                          with needs().may_reject) / stop the run / ask for the next Δt
 //   save_state / load_state  what the model keeps goes into every checkpoint and comes back on --resume
@@ -19,6 +20,7 @@
 #include <bodyfit/mesh.hpp>
 #include <bodyfit/model_outputs.hpp>
 #include <bodyfit/model_state.hpp>
+#include <bodyfit/nucleus.hpp>
 #include <bodyfit/parameters.hpp>
 #include <bodyfit/plugin_abi.hpp>
 
@@ -253,6 +255,13 @@ class VelocityModel {
   /// (`bodyfit run --overwrite` removes them with the driver's own). Default: the declared files
   /// and grids (both formats).
   virtual std::vector<std::string> output_files() const;
+  /// New components of G that the step from T^n creates (ABI 3.1): disks around vertices of T^n,
+  /// which no velocity can make (characteristics only move the fronts there are). Asked once per
+  /// attempt, after the last advection and before the cut, with T^n and d^n; the driver sets
+  /// φ^{n+1} ← min(φ^{n+1}, ψ) (nucleus_level_set) and the review judges the candidate with them.
+  /// `attempt` counts the step's rejections (a model may drop a nucleus the review refused).
+  /// Default: none.
+  virtual std::vector<Nucleus> nuclei(const StepContext& /*state*/, int /*attempt*/) { return {}; }
 };
 
 /// The file names of declared outputs: File outputs as named, Grid outputs as <name>.tif, .asc, .prj.
