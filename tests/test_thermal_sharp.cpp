@@ -1,5 +1,7 @@
 // The sharp problem (4.12) on the body-fitted volume mesh: u = 0 on G exactly. Against the exact
-// solution on the ball held at 0 on its whole sphere, and the smoothed problem's T_ε → T as ε → 0.
+// solution on the ball held at 0 on its whole sphere, the smoothed problem's T_ε → T as ε → 0, and
+// the topological sensitivity against small disks of G inserted into the mesh.
+#include "nucleation.hpp"
 #include "sharp_problem.hpp"
 #include "thermal_fixtures.hpp"
 #include "smoothing.hpp"
@@ -9,6 +11,7 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/levelset_mesher.hpp>
 
 #include <doctest/doctest.h>
 #include <fmt/format.h>
@@ -97,4 +100,68 @@ TEST_CASE("T_eps -> T on the ball held at 0 on a hemisphere, and the sharp probl
   neumann.neumann = lower;
   CHECK_THROWS_WITH_AS(solve_sharp(v, neumann, lower), doctest::Contains("both in G and in the Neumann boxes"),
                        InputError);
+}
+
+TEST_CASE("topological sensitivity: a small disk of G inserted where 4 gamma u p is most negative changes J by "
+          "rho times it, to O(rho)") {
+  // The cube [−1, 1]³ held at 0 on a disk of radius 0.5 centred on its top face; a second disk of
+  // radius ρ is cut into its bottom face, where the part is hottest. ΔJ / (ρ·4γup) = 1 − aρ + O(ρ²)
+  // (the disk shields itself): the deviation from 1 grows linearly with ρ, so its ratio between
+  // ρ = 0.3 and 0.2 is 1.5, and the first-order term is the limit. A wrong constant c in c·ρup
+  // would leave r → 4/c instead, and that ratio away from 1.5.
+  const int n = 48;
+  auto solve = [&](double rho) {
+    SurfaceMesh s = test::make_box(n, {-1, -1, -1}, {1, 1, 1});
+    std::vector<double> phi(s.n_vertices());
+    for (auto v : s.vertices()) {
+      const Vec3& p = s.point(v);
+      double d = 10;
+      if (p[2] == 1) d = std::hypot(p[0], p[1]) - 0.5;
+      if (p[2] == -1 && rho > 0) d = std::hypot(p[0], p[1]) - rho;
+      phi[std::size_t(v.idx())] = d;
+    }
+    discretize(s, phi);
+    FaceMask g(s.n_faces(), 0);
+    for (auto f : s.faces()) g[std::size_t(f.idx())] = s.inside(f);
+    const VolumeMesh v = tetrahedralize(s, {.max_volume = regular_tet_volume(4.0 / n)});
+    SharpSolution solution = solve_sharp(v, {}, g);
+    return std::tuple{std::move(s), std::move(phi), std::move(solution)};
+  };
+  const auto [s, d, before] = solve(0);
+  // u at the surface's vertices (the volume mesh keeps them first) and p = −u/|Ω| (mean temperature).
+  std::vector<double> u(s.n_vertices()), p(s.n_vertices());
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = before.u[Eigen::Index(i)], p[i] = -u[i] / before.volume;
+  const std::vector<double> g = topological_sensitivity(s, u, p, BoxField{1, {}});
+  // Where the sites go: the most negative g (the bottom's corners, the farthest from the cold disk;
+  // the formula's constant is a flat point's, so there g only ranks them and the review judges),
+  // each keeping its clearance from G and from the others.
+  const NucleationOptions options{.radius = 0.2, .clearance = 0.1, .count = 4};
+  const std::vector<int> sites = nucleation_sites(s, d, g, {}, options);
+  REQUIRE(sites.size() == 4);
+  double lowest = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) lowest = std::min(lowest, g[i]);
+  CHECK(g[std::size_t(sites[0])] == lowest);
+  for (std::size_t a = 0; a < sites.size(); ++a) {
+    const Vec3 x = s.point(VertexHandle(sites[a]));
+    CHECK(x[2] == -1);
+    CHECK(std::min(std::abs(x[0]), std::abs(x[1])) > 0.8);  // at a corner (within two cells: the discrete u's)
+    for (std::size_t b = 0; b < a; ++b) CHECK((x - s.point(VertexHandle(sites[b]))).norm() > 2 * options.radius + options.clearance);
+  }
+  // The formula is the flat half-space's: check it at the bottom's centre, a smooth point.
+  int centre = -1;
+  for (auto v : s.vertices())
+    if ((s.point(v) - Vec3(0, 0, -1)).norm() < 1e-12) centre = v.idx();
+  REQUIRE(centre >= 0);
+  const std::vector<int> site{centre};
+  std::vector<double> ratio;
+  for (double rho : {0.2, 0.3}) {
+    const double predicted = rho * g[std::size_t(site[0])];
+    const double realised = std::get<2>(solve(rho)).mean_temperature - before.mean_temperature;
+    ratio.push_back(realised / predicted);
+    MESSAGE(fmt::format("rho {:.2f}: dJ {:.5e}, rho*4*gamma*u*p {:.5e}, ratio {:.4f}", rho, realised, predicted,
+                        ratio.back()));
+    CHECK(realised < 0);
+    CHECK(ratio.back() < 1);
+  }
+  CHECK((1 - ratio[1]) / (1 - ratio[0]) == doctest::Approx(1.5).epsilon(0.1));
 }

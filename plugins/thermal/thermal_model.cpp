@@ -14,6 +14,7 @@
 #include "box_field.hpp"
 #include "descent.hpp"
 #include "fixed_volume.hpp"
+#include "nucleation.hpp"
 #include "objective.hpp"
 #include "shape_derivative.hpp"
 #include "sharp_problem.hpp"
@@ -62,6 +63,7 @@ struct Evaluation {
   std::vector<Vec3> sample_points;   ///< the boundary vertices of the volume mesh
   std::vector<double> band_weights;  ///< ∂T_ε/∂d at sample_points (shape_derivative.hpp)
   ScalarField u_surface, p_surface;  ///< u and p at the state's vertices
+  ScalarField sensitivity;  ///< g = 4γup: J's change per unit radius of a new disk of G (nucleation.hpp)
   ScalarField speed;        ///< the descent speed v computed on this state (empty until then)
   double slope = 0;         ///< M′(v)
   double unit_slope = 0;    ///< M′(v / max |v|): the stationarity measure
@@ -174,6 +176,20 @@ class ThermalModel final : public VelocityModel {
         ParameterDecl::boolean("sharp", "solve the sharp problem (4.12) on every accepted state's volume mesh "
                                         "and report J_sharp (one more solve)")
             .fallback(true),
+        ParameterDecl::integer("nucleation.every", "steps", "a new component of G (a disk) where J's topological "
+                                                            "sensitivity 4γup is most negative, on the steps from "
+                                                            "every k-th state (0: never)")
+            .fallback(0)
+            .within({.min = 0, .max = 1000000}),
+        ParameterDecl::number("nucleation.radius", "length", "ρ of each new disk")
+            .computed("2 × the mean edge h of T^0")
+            .positive(),
+        ParameterDecl::number("nucleation.clearance", "length", "kept between a new disk and G, Γ_N and the other new "
+                                                               "disks")
+            .computed("epsilon + the mean edge h of T^0")
+            .at_least(0),
+        ParameterDecl::integer("nucleation.count", "disks", "new disks at most per nucleation").fallback(1).within(
+            {.min = 1, .max = 1000}),
         ParameterDecl::integer("volume_every", "states", "write volume_NNNNN.vtu (tetrahedra with u) every k states (0: "
                                                          "never)")
             .fallback(0)
@@ -208,10 +224,15 @@ class ThermalModel final : public VelocityModel {
                                                          "G's faces (sharp = true)"),
             OutputDecl::metric("J_sharp", "temperature", "j(u_sharp) + ell·|G|: the objective J_ε approximates"),
             OutputDecl::metric("ms_sharp", "ms", "the sharp problem's assembly and solve"),
+            OutputDecl::metric("nucleated", "disks", "new components of G the accepted step created (nucleation)"),
+            OutputDecl::metric("nucleation_predicted", "temperature", "their predicted change of J: Σ ρ·4γup at the "
+                                                                      "centres"),
             OutputDecl::vertex_field("temperature", "temperature", "u at the surface's vertices"),
             OutputDecl::vertex_field("adjoint", "", "p at the surface's vertices"),
             OutputDecl::vertex_field("shape_gradient", "", "the density w of J′ on the surface"),
             OutputDecl::vertex_field("descent_speed", "1", "v, the normal speed of the descent (max |v| = 1)"),
+            OutputDecl::vertex_field("topological_sensitivity", "temperature/length",
+                                     "4γup: J's change per unit radius of a new disk of G centred there"),
             OutputDecl::file("objective.csv", "j, |G|, J and the slope of every accepted state from T^0, per continuation "
                                               "stage"),
             OutputDecl::file("volume.pvd", "the series of volume_NNNNN.vtu (with volume_every)")};
@@ -252,6 +273,15 @@ class ThermalModel final : public VelocityModel {
     d.tolerance = p.number("tolerance");
     d.patience = int(p.integer("patience"));
     volume_every_ = int(p.integer("volume_every"));
+    if (p.has("nucleation")) {
+      Parameters& n = p.section("nucleation");
+      nucleation_every_ = int(n.integer("every"));
+      nucleation_.radius = n.number("radius", 0);
+      nucleation_.clearance = n.number("clearance", -1);
+      nucleation_.count = int(n.integer("count"));
+      if (nucleation_every_ == 0)
+        for (const char* key : {"radius", "clearance", "count"}) n.not_used(key, "nucleation.every = 0");
+    }
     sharp_ = p.boolean("sharp");
     fixed_volume_ = p.choice("volume_mesh") == "fixed";
     sharp_every_ = int(p.integer("sharp_every"));
@@ -280,11 +310,36 @@ class ThermalModel final : public VelocityModel {
                      {"stationarity", first != 0 ? std::abs(e.unit_slope / first) : 1.0},
                      {"area_rate", e.area_rate},
                      {"ms_regularise", e.ms_direction}};
+    if (e.sensitivity.empty()) e.sensitivity = topological_sensitivity(context.mesh(), e.u_surface, e.p_surface, conductivity_);
     field.point_fields = {{"temperature", e.u_surface},
                           {"adjoint", e.p_surface},
                           {"shape_gradient", e.objective.density},
-                          {"descent_speed", e.speed}};
+                          {"descent_speed", e.speed},
+                          {"topological_sensitivity", e.sensitivity}};
     return field;
+  }
+
+  /// Nucleation: on the steps from every k-th state, disks where 4γup is most negative; none on a
+  /// retry (the review refused the step with them).
+  std::vector<Nucleus> nuclei(const StepContext& state, int attempt) override {
+    nucleated_ = {};
+    const int n = state.iteration();
+    if (nucleation_every_ == 0 || attempt > 0 || n == 0 || n % nucleation_every_ != 0) return {};
+    if (!current_ || current_->iteration != n) return {};
+    Evaluation& e = *current_;
+    if (e.sensitivity.empty()) e.sensitivity = topological_sensitivity(state.mesh(), e.u_surface, e.p_surface, conductivity_);
+    const std::vector<int> sites =
+        nucleation_sites(state.mesh(), state.distance(), e.sensitivity, neumann_vertices(state.mesh()), nucleation_);
+    std::vector<Nucleus> out;
+    for (int v : sites) {
+      out.push_back({v, nucleation_.radius});
+      nucleated_.predicted += nucleation_.radius * e.sensitivity[std::size_t(v)];
+    }
+    nucleated_.count = int(out.size());
+    if (!out.empty())
+      spdlog::info("thermal, step {}: {} new component(s) of G of radius {:.4g}, predicted dJ = {:.4g}", n + 1,
+                   out.size(), nucleation_.radius, nucleated_.predicted);
+    return out;
   }
 
   Review review(const StepContext& candidate, int attempt) override {
@@ -318,6 +373,8 @@ class ThermalModel final : public VelocityModel {
                    "{:.3g}",
                    candidate.iteration(), (J_next - J) / std::abs(J), noise_before, descent_.options().noise);
     if (!verdict.accept) return Review::reject(why);
+    // A new component is judged on its own merit: the shortest-step rule is for the motion's noise.
+    if (verdict.forced && attempt == 0 && nucleated_.count > 0) return Review::reject(why + "; with the new component(s)");
     if (verdict.forced) spdlog::warn("thermal, step {}: the shortest step still raises J ({}); taken", candidate.iteration(), why);
     const double decrease = (J - J_next) / std::abs(J);
     const double lambda = descent_.lambda();
@@ -369,7 +426,9 @@ class ThermalModel final : public VelocityModel {
                  {"ms_solve", t.solve_ms},
                  {"T_sharp", T_sharp},
                  {"J_sharp", j_sharp + ell_ * o.area},
-                 {"ms_sharp", ms_sharp}};
+                 {"ms_sharp", ms_sharp},
+                 {"nucleated", attempt == 0 ? double(nucleated_.count) : 0.0},
+                 {"nucleation_predicted", attempt == 0 ? nucleated_.predicted : 0.0}};
     current_ = std::move(next);  // T^{n+1} is the next compute's state
     return r;
   }
@@ -401,6 +460,7 @@ class ThermalModel final : public VelocityModel {
     state.set("lengths", std::vector<double>{epsilon_, alpha_length_, d.min_step, d.max_step, d.max_motion, speed_scale_,
                                              epsilon_final_});
     state.set("descent", std::vector<double>{d.noise, d.penalty, descent_.lambda(), descent_.motion(), scatter_});
+    if (nucleation_every_ > 0) state.set("nucleation", std::vector<double>{nucleation_.radius, nucleation_.clearance});
     if (fixed_) {  // S⁰, so that a resumed run solves on the same volume mesh
       std::vector<double> points;
       for (const Vec3& x : fixed_->points()) points.insert(points.end(), {x[0], x[1], x[2]});
@@ -450,6 +510,11 @@ class ThermalModel final : public VelocityModel {
       }
       resumed_surface_ = std::move(s0);
       resumed_warm_start_ = state.numbers("warm_start");
+    }
+    if (nucleation_every_ > 0) {  // the radius and clearance resolved on T⁰
+      const auto& nucleation = state.numbers("nucleation");
+      if (nucleation.size() != 2) throw InputError("thermal model state: 'nucleation' needs 2 numbers");
+      nucleation_.radius = nucleation[0], nucleation_.clearance = nucleation[1];
     }
     d.noise = descent[0], d.penalty = descent[1];
     descent_.set_lambda(descent[2]);
@@ -565,6 +630,8 @@ class ThermalModel final : public VelocityModel {
     d.min_step = min_step_factor_ * context.dt();
     d.max_step = max_dt_factor_ * context.dt();
     d.max_motion = std::min(h, epsilon_ / 2);
+    if (!(nucleation_.radius > 0)) nucleation_.radius = 2 * h;
+    if (nucleation_.clearance < 0) nucleation_.clearance = epsilon_ + h;
     lengths_resolved_ = true;
   }
 
@@ -786,6 +853,8 @@ class ThermalModel final : public VelocityModel {
   bool sharp_ = true;  ///< J_sharp of every accepted state
   bool fixed_volume_ = false;  ///< volume_mesh = "fixed"
   int sharp_every_ = 1;
+  int nucleation_every_ = 0;
+  NucleationOptions nucleation_;  ///< radius and clearance resolved on T⁰ (saved in checkpoints)
   // State (saved in checkpoints).
   Descent descent_;          ///< the merit, the records of the accepted states, λ, the step bounds
   double alpha_length_ = 0;  ///< α·h
@@ -799,6 +868,10 @@ class ThermalModel final : public VelocityModel {
   // Per step.
   std::shared_ptr<Evaluation> current_;  ///< u, p, J of T^n (the accepted candidate of the last step)
   double slope_ = 0;                     ///< J′(v) of the current descent speed
+  struct {
+    int count = 0;          ///< new components this attempt adds
+    double predicted = 0;   ///< Σ ρ·g at their centres
+  } nucleated_;
   std::unique_ptr<PvdWriter> volume_pvd_;
 };
 
