@@ -136,6 +136,14 @@ TEST_CASE("thermal model: bad input is a clear error") {
   auto negative = run("--set model.epsilon=-0.1");
   CHECK(negative.exit_code == 1);
   CHECK(negative.output.find("epsilon") != std::string::npos);
+  // Nucleation: a radius given while nucleation is off takes no effect; a radius must be positive.
+  auto off = run("--set model.nucleation.radius=0.2");
+  CHECK(off.exit_code == 1);
+  CHECK_MESSAGE(off.output.find("[model.nucleation] radius is not used") != std::string::npos, off.output);
+  CHECK_MESSAGE(off.output.find("nucleation.every = 0") != std::string::npos, off.output);
+  auto radius = run("--set model.nucleation.every=2 --set model.nucleation.radius=-1");
+  CHECK(radius.exit_code == 1);
+  CHECK_MESSAGE(radius.output.find("radius") != std::string::npos, radius.output);
   // An open surface (a plane) bounds no volume.
   bodyfit::test::TempDir plane_dir("thermal_plane");
   const std::string plane_case = write_case(plane_dir, R"(
@@ -356,4 +364,51 @@ TEST_CASE("a CAD part not made here (CGAL's fan disk): the shipped case ends nor
                       rows.back().at("J_sharp")));
   CHECK(J < 0.2 * J0);
   CHECK(std::isfinite(std::stod(rows.back().at("J_sharp"))));
+}
+
+TEST_CASE("nucleation: new disks of G where 4 gamma u p is most negative reach a design shape derivatives alone do not, "
+          "and a resume continues exactly") {
+  // The shipped bar (4 × 1 × 1, |G| held at 5 % of |S|, one patch at an end), coarsened to h = 0.2
+  // for speed. Without nucleation the patch cannot leave its end: J_sharp stays ≈ 5.3; a disk put
+  // where the sensitivity says cools the far end.
+  bodyfit::test::TempDir dir("thermal_nucleation");
+  const std::string case_file = (std::filesystem::path(BODYFIT_SOURCE_DIR) / "meshes" / "cases" / "thermal_bar_nucleation.toml").string();
+  const std::string coarse = " --set output.vtu_every=0 --set output.png_every=0 --set remesh.hmax=0.2 --set model.epsilon=0.4 "
+                             "--set model.epsilon_final=0.2 --set time.dt=0.1 --set time.iterations=30";
+  const std::string nucleation = coarse + " --set model.nucleation.radius=0.25 --set model.nucleation.every=5";
+  auto with = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "with").string() + nucleation);
+  REQUIRE_MESSAGE(with.exit_code == 0, with.output);
+  auto without = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "without").string() + coarse +
+                                            " --set model.nucleation.every=0");
+  REQUIRE_MESSAGE(without.exit_code == 0, without.output);
+  const Table rows = read_csv(dir / "with" / "history.csv"), alone = read_csv(dir / "without" / "history.csv");
+  int nucleated = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i)
+    if (std::stod(rows[i].at("nucleated")) > 0) {
+      ++nucleated;
+      CHECK(std::stod(rows[i].at("nucleation_predicted")) < 0);
+      CHECK(std::stoi(rows[i].at("components")) > std::stoi(rows[i - 1].at("components")));
+      CHECK(std::stod(rows[i].at("J")) < std::stod(rows[i - 1].at("J")));  // the review kept it: J fell
+    }
+  for (const auto& row : alone) CHECK(row.at("components") == "1");
+  const double J_with = std::stod(rows.back().at("J_sharp")), J_alone = std::stod(alone.back().at("J_sharp"));
+  MESSAGE(fmt::format("bar: J_sharp {:.4f} with {} nucleation(s), {:.4f} from shape derivatives alone", J_with, nucleated,
+                      J_alone));
+  CHECK(nucleated >= 1);
+  CHECK(J_with < 0.5 * J_alone);
+
+  // Interrupted after a nucleation and resumed: the radius and clearance come back from the checkpoint.
+  auto part = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "part").string() + nucleation +
+                                         " --inject-signal 8:INT");
+  CHECK(part.exit_code == 130);
+  auto rest = bodyfit::test::run_bodyfit("run " + case_file + " -o " + (dir / "part").string() + nucleation + " --resume");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  const Table resumed = read_csv(dir / "part" / "history.csv");
+  REQUIRE(resumed.size() == rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (const char* key : {"area", "J", "nucleated", "components"}) {
+      CAPTURE(i);
+      CAPTURE(key);
+      CHECK(resumed[i].at(key) == rows[i].at(key));
+    }
 }

@@ -42,6 +42,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numbers>
 #include <optional>
 
 namespace bodyfit::thermal {
@@ -226,7 +227,8 @@ class ThermalModel final : public VelocityModel {
             OutputDecl::metric("ms_sharp", "ms", "the sharp problem's assembly and solve"),
             OutputDecl::metric("nucleated", "disks", "new components of G the accepted step created (nucleation)"),
             OutputDecl::metric("nucleation_predicted", "temperature", "their predicted change of J: Σ ρ·4γup at the "
-                                                                      "centres"),
+                                                                      "centres, and the merit's change with their "
+                                                                      "area"),
             OutputDecl::vertex_field("temperature", "temperature", "u at the surface's vertices"),
             OutputDecl::vertex_field("adjoint", "", "p at the surface's vertices"),
             OutputDecl::vertex_field("shape_gradient", "", "the density w of J′ on the surface"),
@@ -276,11 +278,13 @@ class ThermalModel final : public VelocityModel {
     if (p.has("nucleation")) {
       Parameters& n = p.section("nucleation");
       nucleation_every_ = int(n.integer("every"));
-      nucleation_.radius = n.number("radius", 0);
-      nucleation_.clearance = n.number("clearance", -1);
-      nucleation_.count = int(n.integer("count"));
-      if (nucleation_every_ == 0)
+      if (nucleation_every_ == 0) {
         for (const char* key : {"radius", "clearance", "count"}) n.not_used(key, "nucleation.every = 0");
+      } else {
+        nucleation_.radius = n.number("radius", 0);
+        nucleation_.clearance = n.number("clearance", -1);
+        nucleation_.count = int(n.integer("count"));
+      }
     }
     sharp_ = p.boolean("sharp");
     fixed_volume_ = p.choice("volume_mesh") == "fixed";
@@ -330,15 +334,17 @@ class ThermalModel final : public VelocityModel {
     if (e.sensitivity.empty()) e.sensitivity = topological_sensitivity(state.mesh(), e.u_surface, e.p_surface, conductivity_);
     const std::vector<int> sites =
         nucleation_sites(state.mesh(), state.distance(), e.sensitivity, neumann_vertices(state.mesh()), nucleation_);
+    // The merit's change: the disks' first-order ρ·g, and what their area costs (ℓ, the constraint).
+    double predicted = 0;
+    for (int v : sites) predicted += nucleation_.radius * e.sensitivity[std::size_t(v)];
+    const double added = double(sites.size()) * std::numbers::pi * nucleation_.radius * nucleation_.radius;
+    predicted += descent_.merit(e.objective.j, e.objective.area + added) - descent_.merit(e.objective.j, e.objective.area);
+    if (sites.empty() || !(predicted < 0)) return {};
     std::vector<Nucleus> out;
-    for (int v : sites) {
-      out.push_back({v, nucleation_.radius});
-      nucleated_.predicted += nucleation_.radius * e.sensitivity[std::size_t(v)];
-    }
-    nucleated_.count = int(out.size());
-    if (!out.empty())
-      spdlog::info("thermal, step {}: {} new component(s) of G of radius {:.4g}, predicted dJ = {:.4g}", n + 1,
-                   out.size(), nucleation_.radius, nucleated_.predicted);
+    for (int v : sites) out.push_back({v, nucleation_.radius});
+    nucleated_ = {int(out.size()), predicted};
+    spdlog::info("thermal, step {}: {} new component(s) of G of radius {:.4g}, predicted dJ = {:.4g}", n + 1, out.size(),
+                 nucleation_.radius, predicted);
     return out;
   }
 
@@ -460,6 +466,7 @@ class ThermalModel final : public VelocityModel {
     state.set("lengths", std::vector<double>{epsilon_, alpha_length_, d.min_step, d.max_step, d.max_motion, speed_scale_,
                                              epsilon_final_});
     state.set("descent", std::vector<double>{d.noise, d.penalty, descent_.lambda(), descent_.motion(), scatter_});
+    if (d.target) state.set("area_target", std::vector<double>{*d.target});  // fixed on T⁰ (area.fraction of |S⁰|)
     if (nucleation_every_ > 0) state.set("nucleation", std::vector<double>{nucleation_.radius, nucleation_.clearance});
     if (fixed_) {  // S⁰, so that a resumed run solves on the same volume mesh
       std::vector<double> points;
@@ -515,6 +522,12 @@ class ThermalModel final : public VelocityModel {
       const auto& nucleation = state.numbers("nucleation");
       if (nucleation.size() != 2) throw InputError("thermal model state: 'nucleation' needs 2 numbers");
       nucleation_.radius = nucleation[0], nucleation_.clearance = nucleation[1];
+    }
+    if (area_target_ > 0 || area_fraction_ > 0) {
+      if (!state.has("area_target") || state.numbers("area_target").size() != 1)
+        throw InputError("thermal model state: the case has a target area and the checkpoint none (written without "
+                         "[model.area]?)");
+      d.target = state.numbers("area_target")[0];
     }
     d.noise = descent[0], d.penalty = descent[1];
     descent_.set_lambda(descent[2]);
