@@ -13,7 +13,7 @@
   scripts/docs.py links                           only the links and paths (no build needed)
   scripts/docs.py [--build DIR] measure [ID ...]  print the figures measured now (all, or those named)
   scripts/docs.py [--build DIR] table             write docs/validation/README.md's table of figures
-  scripts/docs.py [--build DIR] pictures          run the three thermal cases and write the thermal
+  scripts/docs.py [--build DIR] pictures          run the four thermal cases and write the thermal
                                                   tutorial's pictures (docs/images/thermal_*.png)
 
 docs/validation/figures.tsv holds one figure per row: id, scope (quick: seconds, CI runs it; full: a
@@ -181,7 +181,7 @@ def generated_pages(build):
 
 
 def thermal_pictures(build):
-    """The thermal tutorial's pictures, from runs of the two shipped thermal cases."""
+    """The thermal tutorial's pictures, from runs of the shipped thermal cases."""
     bodyfit = str(build / "bin" / "bodyfit")
     images = ROOT / "docs" / "images"
     with tempfile.TemporaryDirectory(prefix="bodyfit_pictures_") as work:
@@ -204,6 +204,21 @@ def thermal_pictures(build):
              "--label", "thermal_bracket_fine (l = 0.05, h = 0.05)", "--label", "thermal_fandisk (l = 0.01, h = 0.05)",
              "--title", "J and J_sharp over the iterations",
              "--y-label", "J", "-o", str(images / "thermal_J.png")])
+        # Nucleation: the bar with and without new components, seen from above and from below.
+        bar = ROOT / "meshes" / "cases" / "thermal_bar_nucleation.toml"
+        for name, extra in (("thermal_bar_nucleation", []), ("thermal_bar_alone", ["--set", "model.nucleation.every=0"])):
+            out = work / name
+            run([bodyfit, "-q", "run", str(bar), "-o", str(out), "--set", "output.png_every=0", "--set",
+                 "output.vtu_every=0"] + extra)
+            runs[name] = (out, int(run(["bash", "-c", PRELUDE + f"last iteration {out}/history.csv"]).split()[-1]))
+            for view, elevation in (("above", "30"), ("below", "-30")):
+                run([bodyfit, "-q", "render", str(out / "final.mesh"), "-o", str(images / f"{name}_{view}.png"),
+                     "--azimuth", "-60", "--elevation", elevation, "--size", "800x400"])
+        run([bodyfit, "-q", "plot", str(runs["thermal_bar_nucleation"][0] / "history.csv"),
+             str(runs["thermal_bar_alone"][0] / "history.csv"), "-y", "J_sharp",
+             "--label", "nucleation every 10 steps", "--label", "shape derivatives alone",
+             "--title", "The bar: J_sharp over the iterations", "--y-label", "J_sharp",
+             "-o", str(images / "thermal_bar_J.png")])
     return {case: last for case, (_, last) in runs.items()}
 
 

@@ -7,6 +7,8 @@
 //                  h′(d/ε) u p on S, then the descent normal speed v: (M + α²K) v = −(M w + ℓ_eff b_Σ),
 //                  zero on Γ_N, normalised to max |v| = 1. On T⁰ it also measures the noise of j:
 //                  j of the same G on a second surface mesh (a full remesh).
+//   nuclei(T^n)    with [model.nucleation], every k-th state: disks of G where the topological
+//                  sensitivity 4γup is most negative (nucleation.hpp), when they lower the merit.
 //   review(T^{n+1}) M on the candidate; the sufficient-decrease test, the next Δt and the stops of
 //                  Descent. The candidate's solution serves the next compute().
 //   state          every accepted state's j, |G| and slope, λ, μ, the noise, ε and α as resolved, the
@@ -79,7 +81,7 @@ class ThermalModel final : public VelocityModel {
   std::string_view description() const override {
     return "shape optimisation of the region G of a part's skin held at temperature 0: descent of "
            "J = j(u) + ell*|G| (mean or L^q-maximum temperature, a region's mean, the dissipation), with an "
-           "optional target area (paper §4.4; TetGen + P1 FEM + CHOLMOD)";
+           "optional target area and topological nucleation (paper §4.4; TetGen + P1 FEM + CHOLMOD)";
   }
 
   std::vector<ParameterDecl> parameters() const override {
