@@ -250,7 +250,7 @@ class Nucleating final : public VelocityModel {
 
 }  // namespace
 
-TEST_CASE("a model's nuclei: a disk where no front is joins G, kept by drop_detached; none from an ABI 3.0 plugin") {
+TEST_CASE("a model's nuclei: a disk where no front is joins G, kept by drop_detached, and none from an ABI 3.0 plugin") {
   CaseConfig config = parse_case(toml::parse(kPlane));
   const double rho = 0.2, r0 = 0.3;
   for (bool drop_detached : {false, true}) {
