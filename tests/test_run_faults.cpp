@@ -6,6 +6,8 @@
 #include <bodyfit/app/case_identity.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/app/config.hpp>
+#include <bodyfit/app/output_lock.hpp>
+#include <bodyfit/error.hpp>
 #include <bodyfit/app/run_directory.hpp>
 
 #include "test_support.hpp"
@@ -146,7 +148,8 @@ TEST_CASE("killed at every write point and resumed: every output byte-identical 
     auto killed = fire.run(out, "--inject-fault " + point);
     REQUIRE_MESSAGE(killed.exit_code == 128 + 9, killed.output);  // the point was reached
     const auto left = names_in(fire.dir / out);
-    if (point == "checkpoint:0") CHECK(left == std::vector<std::string>{"checkpoint.bin"});  // no history.csv yet
+    if (point == "checkpoint:0")  // no history.csv yet; the lock names the killed run
+      CHECK(left == std::vector<std::string>{OutputLock::kFileName, "checkpoint.bin"});
     if (point.starts_with("rename:"))
       CHECK(std::any_of(left.begin(), left.end(), [](const std::string& n) { return is_run_output(n) && n[0] == '.'; }));
     // Killed before its first checkpoint, a run left only a temporary: it starts again (and
@@ -474,4 +477,83 @@ png_every = 0
   auto rest = test::run_bodyfit("run " + file.string() + " -o " + out.string() + " --resume --force");
   REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
   CHECK(fs::exists(out / "final.mesh"));
+}
+
+TEST_CASE("an output directory is one run's at a time: a second run (or --overwrite, or --resume) is refused "
+          "naming the owner, and a lock left by a killed run is taken over") {
+  test::TempDir dir("faults_lock");
+  const fs::path hang = dir / "hang";
+  std::ofstream(hang) << "stuck while this file exists\n";
+  const fs::path file = dir / "case.toml";
+  std::ofstream(file) << fmt::format(R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.1
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.3]
+[model]
+name = "testlifecycle"
+speed = 0.5
+hang_file = "{}"
+[time]
+dt = 0.05
+iterations = 4
+[remesh]
+hmax = 0.1
+[output]
+vtu_every = 0
+png_every = 0
+)", hang.string());
+  ::setenv("BODYFIT_PLUGIN_PATH", BODYFIT_TEST_PLUGIN_DIR, 1);
+  const fs::path out = dir / "out", status = dir / "status";
+  // The first run stalls in its first compute, holding the directory; the others try it meanwhile;
+  // then the first is killed outright (SIGKILL: no chance to release anything).
+  const std::string script = fmt::format(
+      "exe='{}'; case='{}'; out='{}'; d='{}'; "
+      "$exe run $case -o $out > $d/first.log 2>&1 & pid=$!; "
+      "for i in $(seq 600); do [ -s $out/history.csv ] && break; sleep 0.1; done; "
+      "$exe run $case -o $out > $d/second.log 2>&1; echo $? > $d/second.status; "
+      "$exe run $case -o $out --overwrite > $d/overwrite.log 2>&1; echo $? > $d/overwrite.status; "
+      "$exe run $case -o $out --resume --force > $d/resume.log 2>&1; echo $? > $d/resume.status; "
+      "kill -KILL $pid; wait $pid; echo $? > '{}'",
+      BODYFIT_EXE, file.string(), out.string(), dir.path().string(), status.string());
+  std::ofstream(dir / "lock.sh") << script << "\n";
+  REQUIRE(std::system(("bash '" + (dir / "lock.sh").string() + "'").c_str()) == 0);
+  CHECK(test::read_file(status) == "137\n");
+  for (const char* attempt : {"second", "overwrite", "resume"}) {
+    CAPTURE(attempt);
+    const std::string log = test::read_file(dir / (std::string(attempt) + ".log"));
+    CHECK(test::read_file(dir / (std::string(attempt) + ".status")) == "1\n");
+    CHECK_MESSAGE(log.find("is in use by another run (pid ") != std::string::npos, log);
+    CHECK_MESSAGE(log.find(" on host ") != std::string::npos, log);
+  }
+  // The first run's files are its own, untouched by the refused runs.
+  CHECK(test::read_file(out / "case.toml").find("hang_file") != std::string::npos);
+  CHECK(load_checkpoint(out / "checkpoint.bin").run.iteration == 0);
+  // The killed run's lock names it still: the next run takes it over, says so, and finishes.
+  fs::remove(hang);
+  auto rest = test::run_bodyfit("run " + file.string() + " -o " + out.string() + " --resume --force");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  CHECK_MESSAGE(rest.output.find("ended without releasing it (killed?): taken over") != std::string::npos, rest.output);
+  CHECK(fs::exists(out / "final.mesh"));
+  CHECK(test::read_file(out / ".bodyfit.lock").empty());  // released at the end
+}
+
+TEST_CASE("OutputLock (run and ensemble): a second holder is refused, and the directory is free once released") {
+  test::TempDir dir("faults_lock_unit");
+  const fs::path out = dir / "new" / "out";  // created by the lock
+  {
+    const OutputLock first(out);
+    CHECK(test::read_file(out / OutputLock::kFileName).find(fmt::format("pid {} on host ", ::getpid())) == 0);
+    CHECK_THROWS_WITH_AS(OutputLock{out}, doctest::Contains("is in use by another run (pid"), InputError);
+    CHECK_THROWS_WITH_AS(OutputLock::check_free(out), doctest::Contains("is in use by another run"), InputError);
+  }
+  CHECK(test::read_file(out / OutputLock::kFileName).empty());
+  CHECK_NOTHROW(OutputLock::check_free(out));
+  CHECK_NOTHROW(OutputLock::check_free(dir / "absent"));  // makes nothing
+  CHECK_FALSE(fs::exists(dir / "absent"));
+  const OutputLock again(out);
 }

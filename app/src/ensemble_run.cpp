@@ -3,6 +3,7 @@
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/case_identity.hpp>
 #include <bodyfit/app/ensemble.hpp>
+#include <bodyfit/app/output_lock.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/app/run_directory.hpp>
 
@@ -15,6 +16,7 @@
 #include <exception>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -86,11 +88,15 @@ EnsembleSummary run_ensemble(const EnsembleOptions& options, const ProcessGroup&
   run.outdir = options.outdir;
   run.inject_failures = options.inject_failures;
   std::exception_ptr error;
+  std::optional<OutputLock> lock;  // rank 0 owns the directory for the ensemble's life
   try {
     run.spec = read_ensemble_spec(options.case_file, overrides);
     run.domain = make_placement_domain(options.case_file, options.overrides, run.spec);
     check_member_case(run);
-    if (group.rank() == 0) prepare_directory(options, overrides);
+    if (group.rank() == 0) {
+      lock.emplace(options.outdir);
+      prepare_directory(options, overrides);
+    }
   } catch (...) {
     error = std::current_exception();
   }

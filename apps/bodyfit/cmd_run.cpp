@@ -3,6 +3,7 @@
 
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/case_identity.hpp>
+#include <bodyfit/app/output_lock.hpp>
 #include <bodyfit/app/progress.hpp>
 #include <bodyfit/app/run.hpp>
 #include <bodyfit/app/run_directory.hpp>
@@ -131,6 +132,7 @@ int run_case(const RunArguments& args) {
     throw InputError(fmt::format("{}: the output directory {} would overwrite the case file (its case.toml): choose "
                                  "another with -o",
                                  args.case_file, outdir.string()));
+  OutputLock::check_free(outdir);
   if (!args.resume && !args.overwrite) refuse_used_directory(outdir);
   if (args.resume && !fs::exists(checkpoint))
     throw InputError(fmt::format("--resume: no checkpoint in {}: nothing to resume (run without --resume)",
@@ -139,6 +141,9 @@ int run_case(const RunArguments& args) {
   // The model, S and its fixed reference, then T^0 (rebuilt on --resume too: it gives h for the CFL step).
   Run run(std::move(config), outdir);  // moved: a copy of a TOML table forgets where its values were written
   spdlog::info("model '{}' ({})", run.model()->name(), run.model().file().string());
+  // The directory is this run's until it ends; a run that ended since the check above left its files.
+  const OutputLock lock(outdir);
+  if (!args.resume && !args.overwrite) refuse_used_directory(outdir);
 
   RunState start;
   std::optional<Checkpoint> resumed;
