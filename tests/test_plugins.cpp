@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 
 using namespace bodyfit;
@@ -431,4 +432,56 @@ TEST_CASE("StepContext::surface_normals: S's smooth normal at the vertices, the 
     CHECK((on_coarse.surface_normals()[v.idx()] - on_coarse.vertex_normals()[v.idx()]).norm() < 1e-12);
   const StepContext without = StepContext::standalone(fine, d_fine);
   CHECK(without.surface_normals() == without.vertex_normals());
+}
+
+TEST_CASE("plugin files are checked before they are loaded, and probed in a child: a truncated, foreign or "
+          "crashing plugin is a failure named, never a signal death of bodyfit") {
+  test::TempDir dir("plugins_unsafe");
+  const std::string good = test::read_file(std::filesystem::path(BODYFIT_TEST_PLUGIN_DIR) / "bodyfit_testgood.so");
+  REQUIRE(good.size() > 8192);
+  auto write = [&](const std::string& name, const std::string& bytes) {
+    std::ofstream(dir / name, std::ios::binary) << bytes;
+    return dir / name;
+  };
+  // Truncated at several places (a copy interrupted; the dynamic loader died of SIGBUS mapping
+  // past the end), an ELF header alone, another word size, text.
+  for (std::size_t keep : {std::size_t(64), std::size_t(4096), good.size() / 2, good.size() - 1}) {
+    CAPTURE(keep);
+    const auto file = write("bodyfit_cut.so", good.substr(0, keep));
+    const std::string message = error_of([&] { load_plugin_file(file); });
+    const bool named = contains(message, "bodyfit_cut.so: cannot load plugin: a ") && contains(message, "ELF file");
+    CHECK_MESSAGE(named, message);
+  }
+  std::string elf32 = good;
+  elf32[4] = 1;  // ELFCLASS32
+  CHECK(contains(error_of([&] { load_plugin_file(write("bodyfit_elf32.so", elf32)); }), "another word size"));
+  CHECK(contains(error_of([&] { load_plugin_file(write("bodyfit_text.so", "#!/bin/sh\n")); }), "not an ELF"));
+
+  // `bodyfit plugins` over a directory of them, with a plugin whose constructor crashes or exits:
+  // each is listed as a failure, the good ones as plugins, and the listing ends normally.
+  for (const char* how : {"segv", "exit"}) {
+    CAPTURE(how);
+    ::setenv("BODYFIT_PLUGIN_PATH", (dir.path().string() + ":" + BODYFIT_TEST_PLUGIN_DIR).c_str(), 1);
+    ::setenv("BODYFIT_TESTFAULT_CREATE", how, 1);
+    auto listing = test::run_bodyfit("plugins");
+    auto run = test::run_bodyfit("run " + test::source_path("meshes/cases/sphere_cap.toml").string() + " -o " +
+                                 (dir / "out").string() + " --set model.name=\\\"testfault\\\"");
+    ::unsetenv("BODYFIT_TESTFAULT_CREATE");
+    ::setenv("BODYFIT_PLUGIN_PATH", BODYFIT_TEST_PLUGIN_DIR, 1);
+    CHECK_MESSAGE(listing.exit_code == 0, listing.output);
+    CHECK(contains(listing.output, "testgood 3.0"));
+    CHECK(contains(listing.output, "bodyfit_cut.so: cannot load plugin: a truncated ELF file"));
+    CHECK(contains(listing.output, "bodyfit_text.so: cannot load plugin: not an ELF"));
+    CHECK(contains(listing.output, std::string(how) == "segv" ? "bodyfit_testfault.so: crashed while being loaded"
+                                                              : "bodyfit_testfault.so: ended the process while being "
+                                                                "loaded (exit status 4"));
+    // A run of it: the crash or exit is named, with the plugin's file, and nothing is written.
+    CHECK(run.exit_code == (std::string(how) == "segv" ? 128 + 11 : 4));
+    CHECK_MESSAGE(contains(run.output, std::string("model 'bodyfit_testfault.so' ") +
+                                           (std::string(how) == "segv" ? "crashed (SIGSEGV)" : "called exit()") +
+                                           " in bodyfit_create"),
+                  run.output);
+    CHECK(contains(run.output, "before the run wrote anything"));
+    CHECK_FALSE(std::filesystem::exists(dir / "out"));
+  }
 }

@@ -219,6 +219,9 @@ TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and 
       {"stage=finish at=4", "failed in finish at iteration 4: a runtime error from finish", 4, 4},
       {"stage=compute at=2 how=segv", "model 'testfault' crashed (SIGSEGV) in compute at iteration 2", 128 + 11, 0},
       {"stage=compute at=2 how=fpe", "model 'testfault' crashed (SIGFPE) in compute at iteration 2", 128 + 8, 0},
+      // exit() in the model is its failure, not the run's end with status 0 and no final state.
+      {"stage=compute at=2 how=exit", "model 'testfault' called exit() in compute at iteration 2: a model failure", 4, 0},
+      {"stage=review at=3 how=exit", "model 'testfault' called exit() in review at iteration 3: a model failure", 4, 0},
   };
   for (const Fault& fault : faults) {
     CAPTURE(fault.settings);
@@ -229,7 +232,7 @@ TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and 
     auto failed = plane.run(out, sets);
     CHECK_MESSAGE(failed.exit_code == fault.exit_code, failed.output);
     CHECK_MESSAGE(contains(failed.output, fault.message), failed.output);
-    if (fault.exit_code <= 4) CHECK(contains(failed.output, "model 'testfault' failed in "));
+    if (fault.exit_code <= 4 && !contains(fault.settings, "how=exit")) CHECK(contains(failed.output, "model 'testfault' failed in "));
     CHECK(plane.checkpointed(out) == fault.checkpoint);
     if (fault.settings.starts_with("stage=finish")) {  // the completed run's final mesh is on disk
       CHECK(test::read_file(plane.dir / out / "final.mesh") == test::read_file(plane.dir / "reference" / "final.mesh"));
@@ -259,6 +262,16 @@ TEST_CASE("a model failing at any stage: exit 4 naming the model, the stage and 
   CHECK(contains(thrown.output, "model 'testfault' failed in configure: an exception that is not a std::exception"));
   CHECK_FALSE(fs::exists(plane.dir / "configure-input"));
   CHECK_FALSE(fs::exists(plane.dir / "configure-int"));
+  // A crash or exit() in configure: nothing was written, and the report says so (no checkpoint).
+  for (const char* how : {"segv", "exit"}) {
+    CAPTURE(how);
+    auto crashed = plane.run(std::string("configure-") + how, std::string("--set model.stage=configure --set model.how=") + how);
+    CHECK(crashed.exit_code == (std::string(how) == "exit" ? 4 : 128 + 11));
+    CHECK_MESSAGE(contains(crashed.output, "in configure"), crashed.output);
+    CHECK_MESSAGE(contains(crashed.output, "before the run wrote anything"), crashed.output);
+    CHECK_FALSE(contains(crashed.output, "checkpoint on disk is intact"));
+    CHECK_FALSE(fs::exists(plane.dir / (std::string("configure-") + how)));
+  }
 }
 
 TEST_CASE("output directories: a previous run is refused unless --overwrite or --resume, a failed set-up leaves nothing") {

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -61,10 +62,31 @@ extern "C" void on_crash(int signal) {
     put(at, end, stage);
     const int iteration = g_iteration.load();
     if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
-    put(at, end, "; the checkpoint on disk is intact: --resume continues from it\n");
+    put(at, end, iteration >= 0 ? "; the checkpoint on disk is intact: --resume continues from it\n"
+                                : "; before the run wrote anything\n");
     [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
   }
   std::raise(signal);  // a raised (not faulting) signal would otherwise return here
+}
+
+/// exit() called by the model: a model failure (exit 4), not the run's end with status 0 and no
+/// final state. The checkpoint writer may be mid-write: its temporary is removed by the next run.
+extern "C" void on_exit_in_model() {
+  const char* stage = g_stage.load();
+  if (!stage) return;
+  char message[512];
+  char* at = message;
+  const char* end = message + sizeof message - 1;
+  put(at, end, "bodyfit: model '");
+  put(at, end, g_model);
+  put(at, end, "' called exit() in ");
+  put(at, end, stage);
+  const int iteration = g_iteration.load();
+  if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
+  put(at, end, iteration >= 0 ? ": a model failure; the checkpoint on disk is intact: --resume continues from it\n"
+                              : ": a model failure, before the run wrote anything\n");
+  [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+  ::_exit(int(ExitCode::Plugin));
 }
 
 std::string message_of(std::exception_ptr error) {
@@ -95,6 +117,7 @@ void report_model_crashes(const std::string& name) {
     action.sa_flags = SA_RESETHAND | SA_NODEFER | SA_ONSTACK;
     sigemptyset(&action.sa_mask);
     for (int signal : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::sigaction(signal, &action, nullptr);
+    std::atexit(on_exit_in_model);
     return true;
   }();
   (void)installed;

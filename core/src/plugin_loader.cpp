@@ -1,4 +1,5 @@
 // Finding plugins on the search path, dlopen-ing them, checking their ABI and creating models.
+#include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
 #include <bodyfit/shared_object.hpp>
@@ -11,9 +12,14 @@
 #include <fmt/ranges.h>
 
 #include <dlfcn.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <map>
 #include <optional>
@@ -158,9 +164,15 @@ LoadedModel load_plugin_file(const fs::path& file) {
   // leaks (LeakSanitizer, the sanitize stage) and thread-exit hooks into its unmapped code.
   HandleGuard guard{open_shared_object(file, RTLD_LOCAL | RTLD_NODELETE, "plugin")};
 
-  // The ABI first: nothing else of a plugin built against other headers may be trusted.
+  // The ABI first: nothing else of a plugin built against other headers may be trusted. A crash
+  // (or exit()) in the plugin's own code from here on names its file.
+  report_model_crashes(file.filename().string());
   auto abi_function = reinterpret_cast<AbiFunction>(require_symbol(guard.handle, file, "bodyfit_plugin_abi"));
-  std::uint32_t abi = abi_function();
+  std::uint32_t abi = 0;
+  {
+    PluginCall call("bodyfit_plugin_abi", -1);
+    abi = abi_function();
+  }
   if (!abi_compatible(abi))
     throw file_error(file, fmt::format("built against plugin ABI {}, this bodyfit needs {}.x (up to {}): rebuild it "
                                        "against bodyfit {}",
@@ -170,6 +182,7 @@ LoadedModel load_plugin_file(const fs::path& file) {
 
   VelocityModel* model = nullptr;
   try {
+    PluginCall call("bodyfit_create", -1);
     model = create();
   } catch (const std::exception& e) {
     throw file_error(file, fmt::format("bodyfit_create failed: {}", e.what()));
@@ -228,6 +241,55 @@ void configure_model(LoadedModel& model, const toml::table& parameters, const Su
   reader->check_consumed();  // the case's keys: a message of the case file, not of the plugin
 }
 
+namespace {
+
+/// Loads `file` in a child process first ("" when it loads): a plugin that crashes, or ends the
+/// process, while it is loaded and described is reported as a failure, not fatal to the listing.
+std::string probe_in_child(const fs::path& file) {
+  int fds[2];
+  if (::pipe(fds) != 0) return {};  // cannot probe: loaded in this process, as without
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]), ::close(fds[1]);
+    return {};
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    if (const int null = ::open("/dev/null", O_WRONLY); null >= 0) ::dup2(null, STDERR_FILENO);
+    std::string failure;
+    try {
+      (void)load_plugin_file(file).info();
+    } catch (const std::exception& e) {
+      failure = e.what();
+    } catch (...) {
+      failure = file.string() + ": an exception that is not a std::exception";
+    }
+    for (std::size_t done = 0; done < failure.size();) {
+      const ssize_t n = ::write(fds[1], failure.data() + done, failure.size() - done);
+      if (n <= 0) break;
+      done += std::size_t(n);
+    }
+    ::_exit(failure.empty() ? 0 : 1);
+  }
+  ::close(fds[1]);
+  std::string message;
+  char buffer[1024];
+  for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, std::size_t(n));
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    return fmt::format("{}: crashed while being loaded ({})", file.string(), ::strsignal(WTERMSIG(status)));
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 1 && !message.empty()) return message;
+  if (WIFEXITED(status) && WEXITSTATUS(status) != 0)
+    return fmt::format("{}: ended the process while being loaded (exit status {}; it may call exit())", file.string(),
+                       WEXITSTATUS(status));
+  return {};
+}
+
+}  // namespace
+
 std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
   std::map<std::string, PluginInfo> found;  // by file name: the first directory wins
   std::set<std::string> seen;
@@ -235,6 +297,10 @@ std::vector<PluginInfo> discover_plugins(std::vector<std::string>* failures) {
     for (const auto& file : plugin_files(dir)) {
       std::string name = model_name_of(file);
       if (!seen.insert(name).second) continue;
+      if (std::string failure = probe_in_child(file); !failure.empty()) {
+        if (failures) failures->push_back(std::move(failure));
+        continue;
+      }
       try {
         found.emplace(name, load_plugin_file(file).info());
       } catch (const std::exception& e) {

@@ -1,6 +1,7 @@
 // A test model that fails on request: constant normal speed, and at one stage of one iteration it
-// throws (a std::runtime_error, an InputError, an int), crashes (SIGSEGV, SIGFPE) or returns a
-// broken field (a NaN, the wrong size). Its state (the iteration reached, the computes made) goes
+// throws (a std::runtime_error, an InputError, an int), crashes (SIGSEGV, SIGFPE), calls exit(0) or
+// returns a broken field (a NaN, the wrong size); with BODYFIT_TESTFAULT_CREATE=segv or exit in the
+// environment its constructor crashes or exits (a plugin that cannot even be created). Its state (the iteration reached, the computes made) goes
 // through the checkpoint, so that save_state and load_state can fail too.
 #include <bodyfit/error.hpp>
 #include <bodyfit/parameters.hpp>
@@ -9,6 +10,8 @@
 #include <cmath>
 #include <csignal>
 #include <cstdint>
+#include <cstdlib>
+#include <string>
 #include <stdexcept>
 
 namespace {
@@ -17,6 +20,12 @@ using namespace bodyfit;
 
 class FaultModel final : public VelocityModel {
  public:
+  FaultModel() {
+    if (const char* how = std::getenv("BODYFIT_TESTFAULT_CREATE")) {
+      if (std::string(how) == "segv") std::raise(SIGSEGV);
+      if (std::string(how) == "exit") std::exit(0);
+    }
+  }
   std::string_view name() const override { return "testfault"; }
   std::vector<ParameterDecl> parameters() const override {
     return {ParameterDecl::number("speed", "", "normal speed").fallback(1.0),
@@ -25,7 +34,7 @@ class FaultModel final : public VelocityModel {
                                   "where the model fails")
                 .fallback("none"),
             ParameterDecl::integer("at", "", "the iteration it fails at").fallback(0).at_least(0),
-            ParameterDecl::choice("how", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size"},
+            ParameterDecl::choice("how", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size", "exit"},
                                   "how it fails")
                 .fallback("runtime_error")};
   }
@@ -78,6 +87,7 @@ class FaultModel final : public VelocityModel {
     // behaviour, at which the sanitize stage's UBSan stops before any signal is sent.
     if (how_ == "segv") std::raise(SIGSEGV);
     if (how_ == "fpe") std::raise(SIGFPE);
+    if (how_ == "exit") std::exit(0);
     throw std::runtime_error("a runtime error from " + stage_);
   }
 

@@ -17,7 +17,8 @@
 //
 // With report_model_crashes(), a crash inside a call (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT)
 // prints the model, the stage and the iteration to stderr (an async-signal-safe write) before the
-// process dies of the signal, as it would have without the report.
+// process dies of the signal, as it would have without the report; and exit() called inside a call
+// is a model failure: the same report, and exit code 4 instead of the model's status.
 #include <bodyfit/velocity_model.hpp>
 
 #include <string>
