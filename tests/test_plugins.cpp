@@ -150,7 +150,7 @@ TEST_CASE("discover_plugins lists the loadable plugins and reports the others") 
   CHECK(good->parameters[0].key == "value");
   CHECK(good->parameters[0].default_text == "0.5");
   REQUIRE(good->outputs.size() == 1);
-  CHECK(good->outputs[0].name == "iteration");
+  CHECK(good->outputs[0].name == "state");
   CHECK(find("testthrowing"));  // it loads; only its configure fails
   const PluginInfo* conormal = find("conormal");
   REQUIRE(conormal);

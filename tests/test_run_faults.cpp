@@ -570,3 +570,44 @@ TEST_CASE("OutputLock (run and ensemble): a second holder is refused, and the di
   CHECK_FALSE(fs::exists(dir / "absent"));
   const OutputLock again(out);
 }
+
+TEST_CASE("resume against damaged files: garbage after history.csv's rows, a checkpoint recording a case that is "
+          "not TOML, a model metric that cannot be a column; each a named outcome, never an internal error") {
+  Case plane("faults_resume_files", kPlane);
+  auto reference = plane.run("reference");
+  REQUIRE_MESSAGE(reference.exit_code == 0, reference.output);
+
+  // Lines appended to history.csv (by hand, a disk that wrote garbage): dropped with a warning
+  // naming the line; the resumed run writes the rows again.
+  auto part = plane.run("garbage", "--inject-signal 2:INT");
+  REQUIRE(part.exit_code == 130);
+  std::ofstream(plane.dir / "garbage" / "history.csv", std::ios::app) << "not,a,row\n7e,1,2\n\x01\x02\n";
+  auto rest = plane.run("garbage", "--resume");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  CHECK(contains(rest.output, "history.csv:5: not a history row (not,a,row)"));
+  CHECK(test::history_without_timings(plane.dir / "garbage" / "history.csv") ==
+        test::history_without_timings(plane.dir / "reference" / "history.csv"));
+
+  // A checkpoint (intact checksum) whose recorded case is not TOML: refused naming the file and the
+  // line, unless --force.
+  auto part2 = plane.run("case", "--inject-signal 2:INT");
+  REQUIRE(part2.exit_code == 130);
+  {
+    Checkpoint c = load_checkpoint(plane.dir / "case" / "checkpoint.bin");
+    c.case_text = "[model\nname = ";
+    CheckpointSnapshot snapshot;
+    take_snapshot(snapshot, c.mesh, c.run, c.model ? &*c.model : nullptr, c.case_text);
+    save_checkpoint(plane.dir / "case" / "checkpoint.bin", snapshot);
+  }
+  auto refused = plane.run("case", "--resume");
+  CHECK_MESSAGE(refused.exit_code == 1, refused.output);
+  CHECK(contains(refused.output, "checkpoint.bin: the recorded case is not valid TOML (line 1"));
+  auto forced = plane.run("case", "--resume --force");
+  CHECK_MESSAGE(forced.exit_code == 0, forced.output);
+  CHECK(contains(forced.output, "--force: resuming without comparing the cases"));
+
+  // A metric whose name would break history.csv's columns: the model's failure (exit 4).
+  auto metric = plane.run("metric", "--set model.stage=compute --set model.at=1 --set model.how=metric_name");
+  CHECK_MESSAGE(metric.exit_code == 4, metric.output);
+  CHECK(contains(metric.output, "cannot be a column of history.csv"));
+}

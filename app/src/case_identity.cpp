@@ -1,5 +1,7 @@
 #include <bodyfit/app/case_identity.hpp>
 
+#include <bodyfit/error.hpp>
+
 #include <fmt/format.h>
 
 #include <array>
@@ -84,7 +86,15 @@ std::string canonical_case(const toml::table& effective) {
 std::vector<CaseChange> case_changes(const std::string& before, const std::string& after) {
   std::vector<CaseChange> changes;
   if (before == after) return changes;
-  const auto a = flattened(before), b = flattened(after);
+  auto parsed = [](const std::string& text, const char* which) {
+    try {
+      return flattened(text);
+    } catch (const toml::parse_error& e) {
+      throw InputError(fmt::format("the {} case is not valid TOML (line {}: {})", which, e.source().begin.line,
+                                   e.description()));
+    }
+  };
+  const auto a = parsed(before, "recorded"), b = parsed(after, "new");
   auto i = a.begin();
   auto j = b.begin();
   while (i != a.end() || j != b.end()) {

@@ -53,7 +53,14 @@ void prepare_directory(const EnsembleOptions& options, const std::vector<std::st
                        text.str() == ensemble_identity(options.case_file, overrides, false));
     if (!same) {
       std::vector<std::string> keys;
-      for (const CaseChange& change : case_changes(text.str(), identity)) keys.push_back(change.key);
+      std::vector<CaseChange> changes;
+      try {
+        changes = case_changes(text.str(), identity);
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{}: {}: remove the file, or use another output directory", recorded.string(),
+                                     e.what()));
+      }
+      for (const CaseChange& change : changes) keys.push_back(change.key);
       throw InputError(fmt::format("{} holds an ensemble of another case (or other --set or --seed values, or an "
                                    "edited data file: {}; see {}): use another output directory",
                                    options.outdir.string(), fmt::join(keys, ", "), recorded.string()));

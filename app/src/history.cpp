@@ -1,10 +1,13 @@
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/app/history.hpp>
+#include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <charconv>
 #include <fstream>
 #include <sstream>
 
@@ -56,11 +59,22 @@ bool RunHistory::resume(int last_iteration) {
   for (std::size_t c = 0; c < header.size(); ++c)
     if (std::find(fixed.begin(), fixed.end(), header[c]) == fixed.end()) metric_names_.push_back(header[c]);
   int expected = 0;
-  while (std::getline(in, line)) {
+  for (long number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
     const std::vector<std::string> cells = split_csv(line);
-    if (cells.empty() || std::stoi(cells[0]) > last_iteration) break;
-    if (std::stoi(cells[0]) != expected) return false;  // a gap: the caller starts over
+    int iteration = -1;
+    const char* first = cells.empty() ? nullptr : cells[0].data();
+    const auto [end, error] = first ? std::from_chars(first, first + cells[0].size(), iteration)
+                                    : std::from_chars_result{nullptr, std::errc::invalid_argument};
+    if (error != std::errc() || end != first + cells[0].size() || iteration < 0) {
+      // Not a row this program wrote (appended by hand, a damaged disk): what follows is dropped;
+      // the rows up to the checkpoint are what the resumed run keeps and writes again.
+      spdlog::warn("{}:{}: not a history row ({}): it and the lines after it are dropped", file_.string(), number,
+                   line.size() > 60 ? line.substr(0, 60) + "..." : line);
+      break;
+    }
+    if (iteration > last_iteration) break;
+    if (iteration != expected) return false;  // a gap: the caller starts over
     std::vector<std::string> row(fixed.size(), "nan");
     std::vector<std::pair<std::string, std::string>> metrics;
     for (std::size_t c = 0; c < header.size() && c < cells.size(); ++c) {
@@ -77,6 +91,12 @@ bool RunHistory::resume(int last_iteration) {
 
 void RunHistory::add(const IterationRecord& record) {
   const auto& fixed = fixed_columns();
+  for (const auto& [name, value] : record.metrics)
+    if (name.empty() || name.find_first_of(",\"\n\r") != std::string::npos ||
+        std::find(fixed.begin(), fixed.end(), name) != fixed.end())
+      throw PluginError(fmt::format("the model's metric '{}' at iteration {} cannot be a column of history.csv (a "
+                                    "name without commas, quotes or line breaks, other than the driver's columns)",
+                                    name, record.iteration));
   if (record.iteration > 0 && metric_names_.empty())
     for (const auto& [name, value] : record.metrics)
       if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) metric_names_.push_back(name);

@@ -78,8 +78,19 @@ void check_same_case(const Checkpoint& c, const std::string& case_text, bool for
     return;
   }
   auto shown = [](const std::string& value) { return value.empty() ? std::string("(absent)") : value; };
+  std::vector<CaseChange> changes;
+  try {
+    changes = case_changes(c.case_text, case_text);
+  } catch (const InputError& e) {
+    if (!force)
+      throw InputError(fmt::format("{}: {}: the checkpoint is damaged or not one of bodyfit's (--force resumes "
+                                   "without comparing the cases)",
+                                   checkpoint.string(), e.what()));
+    spdlog::warn("{}: {}; --force: resuming without comparing the cases", checkpoint.string(), e.what());
+    return;
+  }
   std::vector<std::string> refused;
-  for (const CaseChange& change : case_changes(c.case_text, case_text)) {
+  for (const CaseChange& change : changes) {
     const std::string text = fmt::format("{}: {} -> {}", change.key, shown(change.before), shown(change.after));
     if (resume_may_change(change.key)) spdlog::info("resuming with {}", text);
     else if (is_input_digest(change.key) && change.before.empty())  // a checkpoint from before the digests

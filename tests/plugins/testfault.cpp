@@ -34,7 +34,7 @@ class FaultModel final : public VelocityModel {
                                   "where the model fails")
                 .fallback("none"),
             ParameterDecl::integer("at", "", "the iteration it fails at").fallback(0).at_least(0),
-            ParameterDecl::choice("how", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size", "exit"},
+            ParameterDecl::choice("how", {"runtime_error", "input_error", "int", "segv", "fpe", "not_finite", "size", "exit", "metric_name"},
                                   "how it fails")
                 .fallback("runtime_error")};
   }
@@ -53,6 +53,7 @@ class FaultModel final : public VelocityModel {
     if (stage_ == "compute" && step_ == at_) {
       if (how_ == "not_finite") field.normal_speed[field.normal_speed.size() / 2] = std::nan("");
       else if (how_ == "size") field.normal_speed.pop_back();
+      else if (how_ == "metric_name") field.metrics.emplace_back("a,b\nc", 1.0);
       else fail();
     }
     return field;

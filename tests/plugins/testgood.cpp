@@ -13,12 +13,12 @@ class GoodModel final : public bodyfit::VelocityModel {
     return {bodyfit::ParameterDecl::number("value", "length/time", "the normal speed").fallback(0.5).at_least(0)};
   }
   std::vector<bodyfit::OutputDecl> outputs() const override {
-    return {bodyfit::OutputDecl::metric("iteration", "1", "the state's iteration")};
+    return {bodyfit::OutputDecl::metric("state", "1", "the state's iteration")};
   }
   void configure(bodyfit::Parameters& p) override { value_ = p.number("value"); }
   bodyfit::VelocityField compute(const bodyfit::StepContext& context) override {
     auto field = bodyfit::VelocityField::normal(bodyfit::ScalarField(context.mesh().n_vertices(), value_));
-    field.metrics.emplace_back("iteration", context.iteration());
+    field.metrics.emplace_back("state", context.iteration());
     return field;
   }
 
