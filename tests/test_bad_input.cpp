@@ -192,6 +192,12 @@ TEST_CASE("bad options of the stage commands are usage errors (exit 2) and write
       {"distance " + kSphere + " --phi {d}/phi.sol --narrow-band -1 -o {d}/out.sol", 2, "--narrow-band", "out.sol"},
       {"mesh sphere --faces 100 --radius nan -o {d}/out.mesh", 2, "--radius", "out.mesh"},
       {"mesh terrain --extent inf -o {d}/out.mesh", 2, "--extent", "out.mesh"},
+      // Whole numbers: a negative one wrapped to 2^64 − n in an unsigned option ("no limit").
+      {"--max-faces -5 " + remesh, 2, "'-5' is not a whole number", "out.mesh"},
+      {"--max-faces 1e3 " + remesh, 2, "'1e3' is not a whole number", "out.mesh"},
+      {"render " + kSphere + " -o {d}/out.png --azimuth nan", 2, "--azimuth", "out.png"},
+      {"render " + kSphere + " -o {d}/out.png --elevation 120", 2, "--elevation", "out.png"},
+      {"render " + kSphere + " -o {d}/out.png --size -5x3", 1, "--size '-5x3'", "out.png"},
   });
 }
 

@@ -1,6 +1,7 @@
 // bodyfit ensemble case.toml: N members of a case with sampled regions and parameters, on
 // local threads or MPI ranks, reduced over the outputs the model declares (docs/reference/ensembles.md).
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/app/ensemble.hpp>
@@ -117,6 +118,7 @@ bodyfit::cli::Command setup_ensemble(CLI::App& app) {
   cmd->add_option("--members", args->members, "number of members (default: ensemble.members of the case)")
       ->check(CLI::Range(std::size_t(1), std::size_t(100000000)));
   cmd->add_option("--seed", args->seed, "seed of the sampling (default: ensemble.seed of the case)")
+      ->check(bodyfit::cli::count())
       ->each([args](const std::string&) { args->seed_given = true; });
   cmd->add_option("--jobs", args->jobs, "members run at once on this process's threads (each gets an equal share "
                                         "of the cores)")

@@ -102,14 +102,19 @@ bodyfit::cli::Command setup_map(CLI::App& app) {
   cmd->add_option("--arrival", args->arrival, "arrival times in seconds, an ESRI ASCII grid (default: the run's)");
   cmd->add_option("--title", args->title, "title above the map")->capture_default_str();
   cmd->add_option("--size", args->size, "image size WxH in pixels")->capture_default_str();
-  cmd->add_option("--interval", args->interval_minutes, "isochrone interval in minutes (default: a 1-2-5 step)");
+  cmd->add_option("--interval", args->interval_minutes, "isochrone interval in minutes (default: a 1-2-5 step)")
+      ->check(bodyfit::cli::finite_above(0));
   cmd->add_option("--time-unit", args->time_unit, "isochrone labels: auto | h | min")
       ->check(CLI::IsMember({"auto", "h", "min"}))
       ->capture_default_str();
   cmd->add_option("--sun-azimuth", args->sun_azimuth, "hillshade sun azimuth, degrees clockwise from north")
+      ->check(bodyfit::cli::finite())
       ->capture_default_str();
-  cmd->add_option("--sun-altitude", args->sun_altitude, "hillshade sun altitude, degrees")->capture_default_str();
+  cmd->add_option("--sun-altitude", args->sun_altitude, "hillshade sun altitude, degrees")
+      ->check(bodyfit::cli::finite_in(0, 90))
+      ->capture_default_str();
   cmd->add_option("--z-factor", args->z_factor, "hillshade relief exaggeration (heights times this)")
+      ->check(bodyfit::cli::finite_above(0))
       ->capture_default_str();
   cmd->add_option("--crs", args->crs, "coordinate system name for the caption (default: from the .prj)");
   cmd->add_option("--at", args->at, "the burnt area at this time, s after t = 0: the arrival raster's cells reached by then")

@@ -1,5 +1,6 @@
 // bodyfit render in.mesh -o out.png: a PNG picture of a mesh, no viewer needed.
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/distance.hpp>
 #include <bodyfit/error.hpp>
@@ -83,8 +84,10 @@ bodyfit::cli::Command setup_render(CLI::App& app) {
   cmd->add_option("--field", args->field, "region | phi | d | quality | height | a .sol file | a point field of the .vtu")
       ->capture_default_str();
   cmd->add_option("--view", args->view, "iso | top | front")->capture_default_str();
-  cmd->add_option("--azimuth", args->azimuth, "camera azimuth in degrees (overrides --view)");
-  cmd->add_option("--elevation", args->elevation, "camera elevation in degrees (overrides --view)");
+  cmd->add_option("--azimuth", args->azimuth, "camera azimuth in degrees (overrides --view)")
+      ->check(bodyfit::cli::finite());
+  cmd->add_option("--elevation", args->elevation, "camera elevation in degrees (overrides --view)")
+      ->check(bodyfit::cli::finite_in(-90, 90));
   cmd->add_option("--size", args->size, "image size WxH")->capture_default_str();
   cmd->add_flag("--perspective", args->perspective, "perspective instead of orthographic projection");
   cmd->add_flag("--no-interface", args->no_interface, "do not draw the interface edges");

@@ -1,5 +1,6 @@
 // bodyfit: body-fitted tracking of a region moving inside a fixed surface.
 #include "commands.hpp"
+#include "validators.hpp"
 #include "mmg_spellings.hpp"
 #include "self_documentation.hpp"
 
@@ -78,7 +79,8 @@ int main(int argc, char** argv) {
       app.add_option("--max-faces", max_faces,
                      fmt::format("refuse to build or remesh to more faces than this, estimated before starting (0: no "
                                  "limit; default: what fits in 3/4 of this machine's memory at {:.0f} bytes per face)",
-                                 kBytesPerFace));
+                                 kBytesPerFace))
+          ->check(bodyfit::cli::count());
   if (!documenting) max_faces_option->capture_default_str();
 
   auto& commands = cli::registry();

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <iterator>
 
@@ -116,7 +117,8 @@ Translation translate_mmg_spellings(std::vector<std::string> arguments, const st
                                      [&](const Unsupported& x) { return a == x.spelling; });
                u != std::end(kUnsupported) && (discretize || remesh)) {
       return refuse(fmt::format("{} (an MMG option) is not supported by `bodyfit {}`: {}", a, command, u->advice));
-    } else if (a.size() > 2 && a[0] == '-' && a[1] != '-' && !is_number(a, nullptr)) {
+    } else if (a.size() > 2 && a[0] == '-' && a[1] != '-' && !is_number(a, nullptr) &&
+               !std::isdigit(static_cast<unsigned char>(a[1])) && a[1] != '.') {  // -5x3: a value
       // A single dash before a word is not an option of bodyfit's (its long options take two): CLI11
       // would read it as a group of one-letter flags, -help… among them.
       return refuse(fmt::format("{}: unknown option (bodyfit's long options take two dashes: -{}; see bodyfit {} --help)",

@@ -5,7 +5,9 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 
@@ -35,6 +37,22 @@ inline CLI::Validator finite_at_least(double low) { return finite_in(low, std::n
 inline CLI::Validator finite() {
   const double inf = std::numeric_limits<double>::infinity();
   return finite_in(-inf, inf);
+}
+
+/// A whole number in [0, high], written in decimal digits: CLI11 reads "-5" into an unsigned option
+/// as 2^64 − 5 (a "no limit" or a seed TOML cannot hold), and "1e3" as an error without a reason.
+inline CLI::Validator count(std::uint64_t high = std::numeric_limits<std::int64_t>::max()) {
+  const std::string what = fmt::format("a whole number in [0, {}]", high);
+  return CLI::Validator(
+      [=](std::string& input) -> std::string {
+        std::uint64_t value = 0;
+        const char* first = input.data() + (input.starts_with('+') ? 1 : 0);
+        const auto [end, error] = std::from_chars(first, input.data() + input.size(), value);
+        if (input.empty() || error != std::errc() || end != input.data() + input.size() || value > high)
+          return "'" + input + "' is not " + what;
+        return {};
+      },
+      what);
 }
 
 }  // namespace bodyfit::cli
