@@ -149,3 +149,19 @@ TEST_CASE("bodyfit discretize at its defaults: the input's size and the evolutio
   const double h = mean_edge_length(sphere);
   CHECK(worst < 1e-2 * h * h);
 }
+
+TEST_CASE("an hmax beyond the surface's extent is reconciled with hausd: the derived hmin no longer overrides it") {
+  // A unit sphere at hmax = 1e300 collapsed to 6 faces (area 4.8 against 4π): hmin = hmax/20 was
+  // above every size hausd asked for. hmax is now the bounding box's diagonal.
+  for (double hmax : {1e300, 1e6, 100.0}) {
+    CAPTURE(hmax);
+    SurfaceMesh sphere = make_sphere({.faces = 2000});
+    const double before = total_area(sphere);
+    RemeshOptions options;
+    options.hmax = hmax;
+    remesh(sphere, options);
+    CHECK(total_area(sphere) == doctest::Approx(before).epsilon(0.01));
+    CHECK(sphere.n_faces() > 300);  // the chords within hausd = diagonal/1000 need edges ≤ 0.17
+    CHECK(euler_characteristic(sphere) == 2);
+  }
+}

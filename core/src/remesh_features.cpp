@@ -4,6 +4,9 @@
 #include <bodyfit/error.hpp>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <atomic>
 
 namespace bodyfit::remesh_detail {
 
@@ -12,6 +15,16 @@ void Remesher::setup_sizes() {
   if (diag <= 0) diag = 1;
   hmax_ = opt_.hmax > 0 ? opt_.hmax : resolution_length(m_);
   if (hmax_ <= 0) hmax_ = diag / 20;
+  if (hmax_ > diag) {
+    // An edge longer than the surface itself means nothing, and hmin, derived from hmax, would then
+    // override hausd (a unit sphere at hmax = 1e300 collapsed to 6 faces, area 4.8 against 12.6).
+    static std::atomic<bool> said{false};
+    if (!said.exchange(true))
+      spdlog::warn("remesh: hmax {:.6g} is above the surface's extent (its bounding box's diagonal, {:.6g}): hmax = "
+                   "{:.6g}{}",
+                   hmax_, diag, diag, opt_.hmin > 0 ? "" : fmt::format(", hmin = {:.6g}", diag / 20));
+    hmax_ = diag;
+  }
   hmin_ = opt_.hmin > 0 ? opt_.hmin : hmax_ / 20;
   if (hmin_ > hmax_) {  // only an hmin given: it asks for coarser than the input's resolution
     if (opt_.hmax > 0)
