@@ -18,6 +18,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -1232,4 +1233,81 @@ TEST_CASE("CLI: writing to an unknown extension fails with one clear line and le
   CHECK(contains(result.output, "x.unknownext"));
   CHECK(contains(result.output, "unknown mesh extension"));
   CHECK(files_in(dir.path()) == 0);
+}
+
+TEST_CASE("polygons of any shape: concave and star-shaped caps keep their area in OBJ, OFF and PLY; a polygon "
+          "crossing itself is refused naming its line") {
+  TempDir dir("io-polygons");
+  // A prism whose caps are a star of `points` tips (radii alternating 1 and `inner`, rotated by
+  // `turn`) and whose sides are quads: every cap is concave, and a fan from its first corner
+  // overlaps itself (a pentagon of area 2.5 became 3.5).
+  struct Star {
+    int points;
+    double inner, turn;
+  };
+  for (const Star& star : {Star{5, 0.4, 0.0}, Star{8, 0.25, 0.3}, Star{12, 0.6, 1.1}, Star{3, 0.2, 0.0}}) {
+    CAPTURE(star.points);
+    const int n = 2 * star.points;
+    const double height = 0.7;
+    std::vector<std::array<double, 2>> outline;
+    for (int i = 0; i < n; ++i) {
+      const double r = i % 2 ? star.inner : 1.0, a = star.turn + 2 * std::numbers::pi * i / n;
+      outline.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+    double area = 0, perimeter = 0;
+    for (int i = 0; i < n; ++i) {
+      const auto &p = outline[std::size_t(i)], &q = outline[std::size_t((i + 1) % n)];
+      area += 0.5 * (p[0] * q[1] - p[1] * q[0]);
+      perimeter += std::hypot(q[0] - p[0], q[1] - p[1]);
+    }
+    std::string vertices, faces_obj, faces_off;
+    for (double z : {0.0, height})
+      for (const auto& p : outline) vertices += fmt::format("{:.17g} {:.17g} {:.17g}\n", p[0], p[1], z);
+    std::vector<std::vector<int>> faces;
+    std::vector<int> bottom, top;
+    for (int i = n - 1; i >= 0; --i) bottom.push_back(i);  // outward: facing −z
+    for (int i = 0; i < n; ++i) top.push_back(n + i);
+    faces.push_back(bottom);
+    faces.push_back(top);
+    for (int i = 0; i < n; ++i) faces.push_back({i, (i + 1) % n, n + (i + 1) % n, n + i});
+    std::string obj, off = fmt::format("OFF\n{} {} 0\n", 2 * n, faces.size()) + vertices;
+    std::istringstream lines(vertices);
+    for (std::string line; std::getline(lines, line);) obj += "v " + line + "\n";
+    for (const auto& f : faces) {
+      obj += "f";
+      off += fmt::format("{}", f.size());
+      for (int c : f) obj += fmt::format(" {}", c + 1), off += fmt::format(" {}", c);
+      obj += "\n", off += "\n";
+    }
+    std::string ply = fmt::format("ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n"
+                                  "property double z\nelement face {}\nproperty list uchar int vertex_indices\n"
+                                  "end_header\n",
+                                  2 * n, faces.size()) +
+                      vertices;
+    for (const auto& f : faces) {
+      ply += fmt::format("{}", f.size());
+      for (int c : f) ply += fmt::format(" {}", c);
+      ply += "\n";
+    }
+    for (const auto& [name, text] : {std::pair{"star.obj", obj}, std::pair{"star.off", off}, std::pair{"star.ply", ply}}) {
+      CAPTURE(name);
+      write_text(dir / name, text);
+      const SurfaceMesh mesh = read_mesh(dir / name);
+      CHECK(mesh.n_faces() == std::size_t(2 * (n - 2) + 2 * n));  // n − 2 triangles per cap
+      CHECK(total_area(mesh) == doctest::Approx(2 * area + perimeter * height).epsilon(1e-12));
+      CHECK(enclosed_volume(mesh) == doctest::Approx(area * height).epsilon(1e-12));
+    }
+  }
+  // A non-planar quad is triangulated in the plane of its normal; a bow tie crosses itself.
+  write_text(dir / "warped.obj", "v 0 0 0\nv 1 0 0.1\nv 1 1 0\nv 0 1 0.1\nf 1 2 3 4\n");
+  CHECK(read_mesh(dir / "warped.obj").n_faces() == 2);
+  write_text(dir / "bowtie.obj", "# a bow tie\nv 0 0 0\nv 2 0 0\nv 0 2 0\nv 2 2 0\nf 1 2 3 4\n");
+  CHECK_THROWS_WITH_AS(read_mesh(dir / "bowtie.obj"),
+                       doctest::Contains("bowtie.obj:6: face 1: a polygon of 4 corners whose outline crosses itself"),
+                       InputError);
+  write_text(dir / "bowtie.off", "OFF\n4 1 0\n0 0 0\n2 0 0\n0 2 0\n2 2 0\n4 0 1 2 3\n");
+  CHECK_THROWS_WITH_AS(read_mesh(dir / "bowtie.off"), doctest::Contains("bowtie.off:7: face 1: a polygon of 4 corners"),
+                       InputError);
+  write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3 4\n");
+  CHECK_THROWS_WITH_AS(read_mesh(dir / "flat.obj"), doctest::Contains("has no area"), InputError);
 }

@@ -1,8 +1,8 @@
 // Wavefront OBJ, read by bodyfit itself into the validated builder (OpenMesh's reader failed an
 // assertion on a malformed face: tests/fuzz/regressions/openmesh-obj-assert-face). Only the
 // geometry a surface needs is read: `v x y z [w | r g b]` and `f` with corners v, v/vt, v//vn or
-// v/vt/vn, 1-based or negative (relative to the last vertex read); a polygon becomes a fan of
-// triangles. Texture coordinates, normals, groups, objects, materials, smoothing groups, lines and
+// v/vt/vn, 1-based or negative (relative to the last vertex read); a polygon becomes triangles
+// (io_polygon.hpp). Texture coordinates, normals, groups, objects, materials, smoothing groups, lines and
 // points are skipped; any other keyword is an error naming its line. A line ending in '\' goes on
 // on the next one.
 #include "io_text.hpp"
@@ -112,7 +112,8 @@ MeshRecords parse_obj(std::string_view bytes, const std::filesystem::path& file)
       if (corners.size() < 3)
         throw file_error(file, line_number,
                          fmt::format("face {} has {} corners, expected at least 3", faces, corners.size()));
-      add_fan(records, corners.data(), std::int64_t(corners.size()), line_number);
+      if (!add_polygon(records, corners.data(), std::int64_t(corners.size()), line_number))
+        throw file_error(file, line_number, fmt::format("face {}: a polygon of {} corners whose outline crosses itself or has no area cannot be triangulated", faces, corners.size()));
     } else if (std::find(kSkipped.begin(), kSkipped.end(), keyword) != kSkipped.end()) {
       continue;
     } else if (free_form(keyword)) {

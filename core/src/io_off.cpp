@@ -129,7 +129,8 @@ MeshRecords parse_text(std::string_view bytes, const OffLayout& layout, Lines& l
                                    : fmt::format("face {}: corner '{}' is not a vertex index (0 to {})", f + 1, w,
                                                  vertices - 1));
     }
-    add_fan(records, corners.data(), count, lines.number());
+    if (!add_polygon(records, corners.data(), count, lines.number()))
+      throw file_error(file, lines.number(), fmt::format("face {}: a polygon of {} corners whose outline crosses itself or has no area cannot be triangulated", f + 1, count));
   }
   return records;
 }
@@ -197,7 +198,8 @@ MeshRecords parse_binary(std::string_view bytes, std::size_t start, const OffLay
     at += 4;
     need(4 * std::uint64_t(colours), "its colour");
     at += 4 * std::size_t(colours);
-    add_fan(records, corners.data(), count, 0);
+    if (!add_polygon(records, corners.data(), count, 0))
+      throw file_error(file, fmt::format("binary OFF: face {}: a polygon of {} corners whose outline crosses itself or has no area cannot be triangulated", f + 1, count));
   }
   return records;
 }

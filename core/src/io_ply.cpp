@@ -377,7 +377,8 @@ void read_body(Body& body, const Header& header, std::int64_t vertices, MeshReco
             if (c < 0 || c >= vertices)
               throw fail(fmt::format("corner {} is not a vertex index (0 to {})", c, vertices - 1));
           }
-          add_fan(records, corners.data(), count, line);
+          if (!add_polygon(records, corners.data(), count, line))
+            throw fail(fmt::format("a polygon of {} corners whose outline crosses itself or has no area cannot be triangulated", count));
         } else if (p.role == Role::Skip) {
           body.skip(1, p.type, place);
         } else {

@@ -2,6 +2,7 @@
 // Private to the text readers (io_off.cpp, io_obj.cpp, io_ply.cpp): lines with their numbers,
 // the words of a line, numbers parsed whole, polygons as fans, counts checked against the length.
 #include "io_internal.hpp"
+#include "io_polygon.hpp"
 
 #include <fmt/format.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 namespace bodyfit::io_detail {
 
@@ -106,13 +108,28 @@ inline void check_counts_fit(std::uint64_t vertices, std::uint64_t faces, double
                                        vertices, faces, needed, size));
 }
 
-/// A polygon of `count` corners as the fan of triangles (0, i, i+1), as OpenMesh did; `line` is
-/// where it was read (ignored by a locator that has no lines).
-inline void add_fan(MeshRecords& records, const std::int64_t* corners, std::int64_t count, long line) {
-  for (std::int64_t i = 1; i + 1 < count; ++i) {
-    records.triangles.push_back({corners[0], corners[i], corners[i + 1]});
+/// A face of `count` corners as triangles: a triangle as it is, a polygon clipped ear by ear
+/// (io_polygon.hpp); `line` is where it was read (ignored by a locator that has no lines). False
+/// when the polygon's outline cannot be triangulated (the caller names the face). Corners not read
+/// yet (a PLY whose faces come before its vertices) give the fan of the first corner; build_mesh
+/// checks the triangles either way.
+inline bool add_polygon(MeshRecords& records, const std::int64_t* corners, std::int64_t count, long line) {
+  auto add = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+    records.triangles.push_back({a, b, c});
     records.triangle_at.push_line(line);
+  };
+  const bool known = std::all_of(corners, corners + count, [&](std::int64_t c) {
+    return c >= 0 && std::uint64_t(c) < records.points.size();
+  });
+  if (count == 3 || !known) {
+    for (std::int64_t i = 1; i + 1 < count; ++i) add(corners[0], corners[i], corners[i + 1]);
+    return true;
   }
+  std::vector<Vec3> outline(static_cast<std::size_t>(count));
+  for (std::int64_t i = 0; i < count; ++i) outline[std::size_t(i)] = records.points[std::size_t(corners[i])];
+  const auto triangles = triangulate_polygon(outline);
+  for (const auto& t : triangles) add(corners[t[0]], corners[t[1]], corners[t[2]]);
+  return !triangles.empty();
 }
 
 }  // namespace bodyfit::io_detail
