@@ -287,6 +287,9 @@ TEST_CASE("case values: non-finite, out of range or too big are input errors (ex
       {run + "advection.max_cells_per_substep=-inf", 1, "not a finite number", "out/final.mesh"},
       {run + "surface.h=1e-5", 1, "[surface] h = 1e-05 on a sphere of radius 1: about", "out/final.mesh"},
       {run + "remesh.hmax=1e-5", 1, "[remesh] hmax = 1e-05: about", "out/final.mesh"},
+      // The run's length in steps is estimated at set-up: too many is refused, not begun.
+      {run + "time.iterations=100000000", 1, "[time] iterations = 100000000 is 1e+08 steps", "out/final.mesh"},
+      {run + "time.max_steps=-1", 1, "max_steps: -1 is out of range", "out/final.mesh"},
       {run + "time.dt=1e6", 1, "sub-steps", "out/final.mesh"},
       {run + "time.dt=1e6 --set time.max_cfl=1 --overwrite", 1, "CFL sub-steps", "out/final.mesh"},
       {run + "time.dt=10 --set time.max_cfl=1 --set time.max_substeps=20 --overwrite", 1, "above the limit of 20", "out/final.mesh"},

@@ -208,6 +208,7 @@ void parse_time(const toml::table& table, TimeSpec& out) {
   out.max_substeps = long(p.integer("max_substeps", out.max_substeps, 0));
   out.final_time = p.number("final_time", out.final_time, kPositive);
   out.iterations = long(p.integer("iterations", -1, 0));
+  out.max_steps = long(p.integer("max_steps", out.max_steps, 0));
   out.max_rejections = clamp_to_int(p.integer("max_rejections", out.max_rejections, 0));
   out.start = p.string("start", "");
   if (p.has("start")) {

@@ -22,6 +22,19 @@
 namespace bodyfit {
 namespace {
 
+/// The steps the case asks for (final_time / Δt, or iterations), refused above [time] max_steps.
+void check_step_count(const TimeSpec& time, double dt, std::size_t faces) {
+  double steps = std::isfinite(time.final_time) ? std::ceil(time.final_time / dt - 1e-9) : HUGE_VAL;
+  if (time.iterations >= 0) steps = std::min(steps, double(time.iterations));
+  if (time.max_steps <= 0 || !(steps > double(time.max_steps))) return;
+  const std::string length = time.iterations >= 0 ? fmt::format("iterations = {}", time.iterations)
+                                                  : fmt::format("final_time = {:.6g} / dt = {:.6g}", time.final_time, dt);
+  throw InputError(fmt::format("[time] {} is {:.3g} steps ({:.3g} face-steps at the {} faces of T^0), above [time] "
+                               "max_steps = {}: give a longer dt (or cfl), a shorter final_time or fewer iterations, "
+                               "or raise max_steps (0: no limit)",
+                               length, steps, steps * double(faces), faces, time.max_steps));
+}
+
 /// One feature of an ignition layer: where, in plan view, and when (seconds after t = 0).
 struct Ignition {
   PlanGeometry shape;
@@ -228,6 +241,7 @@ CaseSetup setup_case(const CaseConfig& config) {
   options.max_rejections = config.time.max_rejections;
   options.cfl_length = setup.h;
   options.max_iterations = config.time.iterations;
+  check_step_count(config.time, options.dt, mesh.n_faces());
   options.distance = config.distance;
   options.advection = config.advection;
   options.discretize = config.discretize;

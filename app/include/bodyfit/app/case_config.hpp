@@ -91,6 +91,9 @@ struct TimeSpec {
   long max_substeps = 10000;  ///< sub-steps one step may take (0: no limit; EvolutionOptions::max_substeps)
   double final_time = std::numeric_limits<double>::infinity();
   long iterations = -1;  ///< −1: no limit (final_time decides)
+  /// Steps a run may take (final_time / dt, or iterations; 0: no limit): a Δt far too short for the
+  /// run's length is an input error at set-up, naming the count, not a run of 10¹² steps.
+  long max_steps = 1000000;
   /// A step the velocity model rejects is retried with half the time step at most this many times
   /// before the run stops (0: stop at the first rejection).
   int max_rejections = 5;
