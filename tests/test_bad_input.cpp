@@ -86,6 +86,7 @@ void make_fixtures(const fs::path& dir) {
   const SurfaceMesh mesh = make_sphere(sphere);
   write_mesh(mesh, dir / "s.mesh");
   write_mesh(mesh, dir / "s.obj");
+  fs::create_symlink("/dev/zero", dir / "zero.mesh");  // a device that never ends
   // Refs beyond 32 bits (4294967299 = 2^32 + 3 wrapped to 3: a face joined G silently).
   std::ofstream(dir / "wide_ref.mesh") << "MeshVersionFormatted 2\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 "
                                           "0\nTriangles\n1\n1 2 3 4294967299\nEnd\n";
@@ -228,6 +229,7 @@ TEST_CASE("MMG's spellings are aliases on discretize and remesh, refused with th
 TEST_CASE("damaged, truncated or inconsistent files are input errors (exit 1) naming the file") {
   run_probes("files", {
       {"info {d}/random.obj", 1, "random.obj:", ""},
+      {"info {d}/zero.mesh", 1, "zero.mesh: not a regular file, and still going after 1 GiB", ""},
       {"info {d}/wide_ref.mesh", 1, "wide_ref.mesh:10: the triangle ref 4294967299 does not fit in 32 bits", ""},
       {"info {d}/wide_vertex_ref.mesh", 1, "the vertex ref -2147483649 does not fit in 32 bits", ""},
       {"info {d}/random.stl", 1, "random.stl: binary STL: the header declares", ""},

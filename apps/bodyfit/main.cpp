@@ -11,6 +11,8 @@
 
 #include <fmt/format.h>
 
+#include <new>
+
 #include <malloc.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -134,6 +136,10 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     const ExitCode code = exit_code_of(e);
     if (code == ExitCode::Internal) spdlog::error("internal error: {}", e.what());
+    else if (dynamic_cast<const std::bad_alloc*>(&e))
+      spdlog::error("out of memory: the input or the options ask for more than this machine has ({}; the estimates "
+                    "refuse what they foresee: see --max-faces)",
+                    e.what());
     else spdlog::error("{}", e.what());
     return int(code);
   }

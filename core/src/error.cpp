@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <new>
+
 namespace bodyfit {
 
 ExitCode exit_code_of(const std::exception& e) {
@@ -12,6 +14,9 @@ ExitCode exit_code_of(const std::exception& e) {
   // std::filesystem operations of the drivers (creating an output directory, removing a stale
   // file): the reading side checks its files itself, so what is left is writing.
   if (dynamic_cast<const std::filesystem::filesystem_error*>(&e)) return ExitCode::Io;
+  // Memory exhausted: not a bug, but more than this machine holds for what was asked (the size
+  // estimates refuse what they can foresee; --max-faces).
+  if (dynamic_cast<const std::bad_alloc*>(&e)) return ExitCode::Input;
   return ExitCode::Internal;
 }
 

@@ -74,8 +74,11 @@ FileBytes::FileBytes(const std::filesystem::path& file) {
     ::close(fd);
     return;
   }
-  // Small files, pipes, /proc: read in blocks.
-  if (stated && S_ISREG(st.st_mode)) copy_.reserve(std::size_t(st.st_size));
+  // Small files, pipes, /proc: read in blocks. What is not a regular file has no size to trust:
+  // a device such as /dev/zero never ends, so a stream is read up to a bound.
+  const bool regular = stated && S_ISREG(st.st_mode);
+  if (regular) copy_.reserve(std::size_t(st.st_size));
+  constexpr std::size_t kStreamLimit = std::size_t(1) << 30;
   char chunk[1 << 16];
   for (;;) {
     const ssize_t got = ::read(fd, chunk, sizeof chunk);
@@ -85,6 +88,12 @@ FileBytes::FileBytes(const std::filesystem::path& file) {
       throw fail(errno);
     }
     copy_.append(chunk, std::size_t(got));
+    if (!regular && copy_.size() > kStreamLimit) {
+      ::close(fd);
+      throw file_error(file, fmt::format("not a regular file, and still going after {} GiB (a device such as "
+                                         "/dev/zero?): save it to a file first",
+                                         kStreamLimit >> 30));
+    }
   }
   ::close(fd);
 }
