@@ -4,6 +4,7 @@
 // output directories (a previous run is refused unless --overwrite or --resume; a failed set-up
 // leaves nothing); --resume with another case is refused unless --force.
 #include <bodyfit/app/case_identity.hpp>
+#include <bodyfit/atomic_file.hpp>
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/app/config.hpp>
 #include <bodyfit/app/output_lock.hpp>
@@ -610,4 +611,18 @@ TEST_CASE("resume against damaged files: garbage after history.csv's rows, a che
   auto metric = plane.run("metric", "--set model.stage=compute --set model.at=1 --set model.how=metric_name");
   CHECK_MESSAGE(metric.exit_code == 4, metric.output);
   CHECK(contains(metric.output, "cannot be a column of history.csv"));
+}
+
+TEST_CASE("a file-size limit (ulimit -f): an I/O error naming it, exit 6, and no temporary left behind") {
+  Case plane("faults_fsize", kPlane);
+  const fs::path out = plane.dir / "out", log = plane.dir / "log";
+  // SIGXFSZ killed the run (status 153) with its .checkpoint.bin.tmp… left in the directory.
+  const std::string script = fmt::format("ulimit -f 64; '{}' run '{}' -o '{}' > '{}' 2>&1; echo $? >> '{}'", BODYFIT_EXE,
+                                         plane.file.string(), out.string(), log.string(), log.string());
+  std::ofstream(plane.dir / "fsize.sh") << script << "\n";
+  REQUIRE(std::system(("bash '" + (plane.dir / "fsize.sh").string() + "'").c_str()) == 0);
+  const std::string output = test::read_file(log);
+  CHECK_MESSAGE(output.ends_with("\n6\n"), output);
+  CHECK_MESSAGE(contains(output, "write failed (File too large)"), output);
+  for (const auto& name : names_in(out)) CHECK_FALSE(is_atomic_temporary(name));
 }

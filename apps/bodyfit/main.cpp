@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include <csignal>
 #include <new>
 
 #include <malloc.h>
@@ -50,6 +51,9 @@ int main(int argc, char** argv) {
   // by about a fifth (docs/validation/performance.md).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  // A file-size limit (ulimit -f) makes a write fail with EFBIG, an I/O error that removes its
+  // temporary, instead of SIGXFSZ killing the process with the temporary left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   // The build's own documentation of the command line (self_documentation.hpp) names no path of
   // this machine.
   const bool documenting = argc == 2 && (std::string_view(argv[1]) == "--man-page" ||

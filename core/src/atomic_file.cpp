@@ -38,9 +38,13 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out)
       throw write_error(target, fmt::format("cannot write in {} ({})", temp.parent_path().string(), std::strerror(errno)));
+    errno = 0;  // what the failing write(2) leaves: ENOSPC, EFBIG (a file-size limit), EIO…
     write(out);
     out.flush();
-    if (!out) throw write_error(target, "write failed (disk full?)");
+    if (!out) {
+      const int error = errno;
+      throw write_error(target, fmt::format("write failed ({})", error ? std::strerror(error) : "disk full?"));
+    }
   });
 }
 
