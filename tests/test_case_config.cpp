@@ -331,7 +331,8 @@ iterations = 1
   }
 }
 
-TEST_CASE("Parameters::path resolves file names against the case file, --set values against the working directory") {
+TEST_CASE("file names resolve against the case file, --set values against the working directory (Parameters::path, "
+          "[surface], [region])") {
   namespace fs = std::filesystem;
   test::TempDir dir("case_paths");
   fs::create_directories(dir / "cases");
@@ -361,6 +362,20 @@ TEST_CASE("Parameters::path resolves file names against the case file, --set val
   // A table parsed from a string has no file: its names are relative to the working directory.
   toml::table text = toml::parse("f = \"a/b.asc\"");
   CHECK(Parameters(text).path("f") == fs::absolute(dir.path()) / "a" / "b.asc");
+  // The engine's own file names ([surface] file and dem, [region] sol and file) follow the same
+  // rule: the case file's directory, or the working directory for a --set value. (A --set
+  // surface.dem was resolved against the case file's directory: another DEM was used silently.)
+  {
+    std::string text = kValidCase;
+    const std::string generator = "generator = \"sphere\"\nfaces = 320\n";
+    REQUIRE(text.find(generator) != std::string::npos);
+    text.replace(text.find(generator), generator.size(), "file = \"part.mesh\"\n");
+    std::ofstream(dir / "cases" / "f.toml") << text;
+  }
+  CaseConfig own = read_case(fs::path("cases") / "f.toml", {});
+  CaseConfig set = read_case(fs::path("cases") / "f.toml", {"surface.file=\"here.mesh\""});
+  CHECK(own.surface.file == cases / "part.mesh");
+  CHECK(set.surface.file == fs::absolute(dir.path()) / "here.mesh");
   fs::current_path(previous);
   // Not a string: the usual typed error.
   toml::table wrong = toml::parse("f = 3");

@@ -1235,7 +1235,7 @@ TEST_CASE("CLI: writing to an unknown extension fails with one clear line and le
   CHECK(files_in(dir.path()) == 0);
 }
 
-TEST_CASE("polygons of any shape: concave and star-shaped caps keep their area in OBJ, OFF and PLY; a polygon "
+TEST_CASE("polygons of any shape: concave and star-shaped caps keep their area in OBJ, OFF and PLY, and a polygon "
           "crossing itself is refused naming its line") {
   TempDir dir("io-polygons");
   // A prism whose caps are a star of `points` tips (radii alternating 1 and `inner`, rotated by

@@ -190,7 +190,7 @@ TEST_CASE("bodyfit plugins --describe: a model's parameters and outputs, as text
   REQUIRE(markdown.exit_code == 0);
   CHECK(contains(markdown.output, "## `testgood` 3.0"));
   CHECK(contains(markdown.output, "| `value` | number | length/time | 0.5 | [0, inf) | the normal speed |"));
-  CHECK(contains(markdown.output, "| `iteration` | history column | 1 | the state's iteration |  |"));
+  CHECK(contains(markdown.output, "| `state` | history column | 1 | the state's iteration |  |"));
   auto unknown = test::run_bodyfit("plugins --describe testgod");
   CHECK(unknown.exit_code == 1);
   CHECK(contains(unknown.output, "did you mean 'testgood'?"));

@@ -36,18 +36,13 @@ int clamp_to_int(std::int64_t value) {
   return int(std::clamp<std::int64_t>(value, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
 }
 
-/// A file name of the case, relative to the case file's directory ("" stays empty).
-std::filesystem::path resolve(const std::filesystem::path& base_dir, const std::string& name) {
-  return name.empty() ? std::filesystem::path() : base_dir / name;
-}
-
 /// A polar angle in degrees, strictly between the pole and the antipode.
 double check_angle(const Parameters& p, std::string_view key, double degrees) {
   if (!(degrees > 0 && degrees < 180)) p.fail(key, fmt::format("must be in (0, 180) degrees (got {})", degrees));
   return degrees;
 }
 
-void parse_surface(const toml::table& table, const std::filesystem::path& base_dir, SurfaceSpec& out) {
+void parse_surface(const toml::table& table, const std::filesystem::path& sourceless, SurfaceSpec& out) {
   if (!table.contains("surface")) throw InputError("missing table [surface] (file = ... or generator = ...)");
   Parameters p(table["surface"].as_table(), "surface");
   const bool has_file = p.has("file");
@@ -57,7 +52,7 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
   if (has_file == has_generator) p.fail("give exactly one of 'file' and 'generator'");
   if (has_file) {
     out.kind = SurfaceSpec::Kind::File;
-    out.file = resolve(base_dir, p.string("file", ""));
+    out.file = p.path("file", "", sourceless);
     p.forbid({"faces", "radius", "h", "extent", "seed", "dem", "nodata", "reproject", "size", "max_height", "feature_size"},
              "to a surface read from a file");
   } else {
@@ -84,7 +79,7 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
       out.terrain.seed = std::uint64_t(p.integer("seed", std::int64_t(out.terrain.seed)));
       out.terrain.max_height = p.number("max_height", out.terrain.max_height);
       out.terrain.feature_size = p.number("feature_size", out.terrain.feature_size, kPositive);
-      out.dem = resolve(base_dir, p.string("dem", ""));
+      out.dem = p.path("dem", "", sourceless);
       if (out.dem.empty()) {
         p.forbid({"nodata", "reproject"}, "to a procedural terrain (no 'dem')");
       } else {
@@ -103,7 +98,7 @@ void parse_surface(const toml::table& table, const std::filesystem::path& base_d
   p.reject_unknown();
 }
 
-void parse_region(const toml::table& table, const std::filesystem::path& base_dir, RegionSpec& out) {
+void parse_region(const toml::table& table, const std::filesystem::path& sourceless, RegionSpec& out) {
   if (!table.contains("region")) throw InputError("missing table [region] (shape = refs|sol|cap|disks)");
   Parameters p(table["region"].as_table(), "region");
   if (!p.has("shape")) p.fail("missing key 'shape' (refs, sol, cap or disks)");
@@ -125,7 +120,7 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
     out.kind = RegionSpec::Kind::Sol;
     p.accept("sol");
     if (!p.has("sol")) p.fail("shape 'sol': missing key 'sol' (the φ file)");
-    out.sol = resolve(base_dir, p.string("sol", ""));
+    out.sol = p.path("sol", "", sourceless);
     p.forbid({"refs", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'sol'");
   } else if (shape == "cap") {
     out.kind = RegionSpec::Kind::Cap;
@@ -158,7 +153,7 @@ void parse_region(const toml::table& table, const std::filesystem::path& base_di
     out.kind = RegionSpec::Kind::Ignitions;
     p.accept("file");
     if (!p.has("file")) p.fail("shape 'ignitions': missing key 'file' (a vector layer: .geojson, .shp, .gpkg)");
-    out.ignitions = resolve(base_dir, p.string("file", ""));
+    out.ignitions = p.path("file", "", sourceless);
     out.ignition_radius = p.number("radius", 0, {.min = 0});
     out.time_attribute = p.string("time_attribute", "");
     p.forbid({"refs", "sol", "axis", "angle", "axes", "angles", "center", "centers", "radii"}, "to shape 'ignitions'");
@@ -323,6 +318,11 @@ void apply_override(toml::table& table, const std::string& assignment) {
 }
 
 CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir) {
+  return parse_case(table, base_dir, base_dir);
+}
+
+CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir,
+                      const std::filesystem::path& sourceless) {
   CaseConfig config;
   config.base_dir = base_dir;
   config.effective = table;
@@ -335,8 +335,8 @@ CaseConfig parse_case(const toml::table& table, const std::filesystem::path& bas
     }
     if (!value.is_table()) throw InputError(fmt::format("{}'{}' must be a table [{}]", location_of(value), k, k));
   }
-  parse_surface(table, base_dir, config.surface);
-  parse_region(table, base_dir, config.region);
+  parse_surface(table, sourceless, config.surface);
+  parse_region(table, sourceless, config.region);
   parse_model(table, config);
   parse_time(table, config.time);
   parse_stages(table, config);
@@ -360,7 +360,9 @@ toml::table read_case_table(const std::filesystem::path& file, const std::vector
 CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
   toml::table table = read_case_table(file, overrides);
   try {
-    CaseConfig config = parse_case(table, file.parent_path());
+    // The case file's values carry their source; a --set value has none and is relative to the
+    // working directory, where the command line was typed.
+    CaseConfig config = parse_case(table, file.parent_path(), std::filesystem::path());
     config.file = file;
     // Moved, not copied: toml++ copies drop the source file of each value, which
     // Parameters::path needs to resolve a model's file names against the case file.

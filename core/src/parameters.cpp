@@ -329,6 +329,11 @@ std::string Parameters::string(std::string_view key, std::string fallback) {
 }
 
 std::filesystem::path Parameters::path(std::string_view key, std::string fallback) {
+  return path(key, std::move(fallback), std::filesystem::path());
+}
+
+std::filesystem::path Parameters::path(std::string_view key, std::string fallback,
+                                       const std::filesystem::path& sourceless) {
   declared(key, {ParameterType::Path});
   const bool present = has(key);
   std::string text = string(key, std::move(fallback));
@@ -337,7 +342,7 @@ std::filesystem::path Parameters::path(std::string_view key, std::string fallbac
   if (name.is_absolute()) return name.lexically_normal();
   const auto& source = table_.get(key)->source();
   // toml++ keeps the name given to parse_file, relative to the working directory of that call.
-  std::filesystem::path base = source.path ? std::filesystem::path(*source.path).parent_path() : std::filesystem::path();
+  std::filesystem::path base = source.path ? std::filesystem::path(*source.path).parent_path() : sourceless;
   return std::filesystem::absolute(base / name).lexically_normal();
 }
 

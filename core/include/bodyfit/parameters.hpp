@@ -168,6 +168,9 @@ class Parameters {
   /// a table parsed from a string) resolves against the current working directory. The result is
   /// absolute and lexically normal; `fallback` is returned as given when the key is absent.
   std::filesystem::path path(std::string_view key, std::string fallback);
+  /// The same, with a value that has no source file resolved against `sourceless` instead of the
+  /// working directory (a case given as text with the directory it stands for).
+  std::filesystem::path path(std::string_view key, std::string fallback, const std::filesystem::path& sourceless);
   /// A string among `allowed`.
   std::string choice(std::string_view key, std::string fallback, const std::vector<std::string>& allowed);
   /// An array of numbers; `size` (when given) is the required length.

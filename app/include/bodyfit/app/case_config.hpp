@@ -141,8 +141,12 @@ void apply_override(toml::table& table, const std::string& assignment);
 /// Read a TOML file (a case, a run's case.toml) and apply the overrides in order, unvalidated.
 /// A missing file or a syntax error is an InputError naming the file (and the line).
 toml::table read_case_table(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
-/// Validate a case table and turn it into a CaseConfig (throws InputError).
+/// Validate a case table and turn it into a CaseConfig (throws InputError). File names resolve
+/// against the file each value was read from (Parameters::path); a value without one, against
+/// `sourceless` — `base_dir` unless given (a case given as text stands for a file in base_dir).
 CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir = {});
+CaseConfig parse_case(const toml::table& table, const std::filesystem::path& base_dir,
+                      const std::filesystem::path& sourceless);
 /// Read a case file, apply the overrides in order, validate.
 CaseConfig read_case(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 
