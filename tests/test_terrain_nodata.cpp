@@ -3,6 +3,7 @@
 // bound of the valid cells'), it stays so through a remesh, and pieces that touch at a point or are
 // tiny are dealt with; `nodata = "fill"` keeps the old nearest-valid surface.
 #include <bodyfit/error.hpp>
+#include <bodyfit/app/dem.hpp>
 #include <bodyfit/app/terrain.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
@@ -15,6 +16,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <string>
 
@@ -232,4 +234,48 @@ TEST_CASE("terrain over NODATA: bodyfit mesh terrain says how many cells it left
   // Without a DEM there is no NODATA: a usage error.
   const auto no_dem = test::run_bodyfit(fmt::format("mesh terrain --nodata fill -o {}", (dir / "p.mesh").string()));
   CHECK(no_dem.exit_code == 2);
+}
+
+TEST_CASE("DEM outliers: an undeclared NODATA marker is NODATA, a lone spike or pit takes its neighbours' median, "
+          "a cliff and real DEMs are left as they are") {
+  test::TempDir dir("dem_outliers");
+  // A smooth slope 40 × 30 cells of 25 m, with a cliff of 400 m across it (a real feature: a whole
+  // line of cells far off their neighbours), a spike of 1e6 m, a pit of −5000 m and an undeclared
+  // −32768 marker.
+  const int cols = 40, rows = 30;
+  auto height = [](int r, int c) { return 300.0 + 2.0 * c + 1.5 * r + (c >= 20 ? 400.0 : 0.0); };
+  std::vector<double> z;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) z.push_back(height(r, c));
+  z[5 * cols + 7] = 1e6;
+  z[12 * cols + 30] = -5000;
+  z[20 * cols + 10] = -32768;
+  std::string text = fmt::format("ncols {}\nnrows {}\nxllcorner 500000\nyllcorner 4000000\ncellsize 25\n"
+                                 "NODATA_value -9999\n",
+                                 cols, rows);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) text += fmt::format("{} ", z[std::size_t(r * cols + c)]);
+    text += "\n";
+  }
+  std::ofstream(dir / "dem.asc") << text;
+  const HeightGrid grid = read_dem(dir / "dem.asc");
+  CHECK(grid.at(5, 7) == doctest::Approx(height(5, 7)).epsilon(0.02));  // the spike: its neighbours' median
+  CHECK(grid.at(12, 30) == doctest::Approx(height(12, 30)).epsilon(0.02));  // the pit
+  CHECK_FALSE(grid.valid(20, 10));  // the marker: NODATA
+  std::size_t changed = 0;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c)
+      if (grid.valid(std::size_t(r), std::size_t(c)) && grid.at(std::size_t(r), std::size_t(c)) != height(r, c)) ++changed;
+  CHECK(changed == 2);  // the cliff stays, and so does every other cell
+  // The shipped DEMs (a real one among them) come back exactly as written.
+  for (const char* name : {"hill.asc", "luxembourg_elev_200m.asc"}) {
+    CAPTURE(name);
+    const auto path = test::source_path(std::string("meshes/dem/") + name);
+    const HeightGrid screened = read_dem(path), raw = read_esri_ascii_values(path);
+    REQUIRE(screened.heights.size() == raw.heights.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < raw.heights.size(); ++i)
+      differ += !(screened.heights[i] == raw.heights[i] || (std::isnan(screened.heights[i]) && raw.heights[i] == raw.nodata));
+    CHECK(differ == 0);
+  }
 }

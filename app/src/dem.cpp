@@ -9,6 +9,7 @@
 #include "gis_module.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 
@@ -24,6 +25,7 @@
 #include <optional>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 namespace bodyfit {
 namespace {
@@ -45,6 +47,85 @@ void check_heights(const HeightGrid& grid, const std::filesystem::path& file) {
       throw file_error(file, fmt::format("the height {} of the cell at row {}, column {} is beyond ±{:.0e}: not a "
                                          "terrain height (a NODATA value the header does not declare?)",
                                          grid.heights[i], i / grid.cols + 1, i % grid.cols + 1, kMaxHeight));
+}
+
+// NODATA markers of common formats: never heights. A DEM whose header does not declare its marker
+// would otherwise carry pits 10 km deep (the fire then ran down them without a word).
+constexpr double kMarkers[] = {-9999.0, -99999.0, -32768.0, -32767.0, -3.4028234663852886e38};
+
+/// An undeclared marker becomes NODATA; a cell standing alone far off its neighbours (a spike or a
+/// pit: a damaged cell, a tower in a surface model) takes their median. Both said, naming cells.
+void screen_heights(HeightGrid& grid, const std::filesystem::path& file) {
+  const std::size_t rows = grid.rows, cols = grid.cols, n = grid.heights.size();
+  std::vector<std::string> markers;
+  std::size_t marked = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    double& z = grid.heights[i];
+    if (is_nodata(z, grid.nodata) || std::find(std::begin(kMarkers), std::end(kMarkers), z) == std::end(kMarkers)) continue;
+    if (markers.size() < 5) markers.push_back(fmt::format("row {}, column {}: {}", i / cols + 1, i % cols + 1, z));
+    z = std::numeric_limits<double>::quiet_NaN();
+    ++marked;
+  }
+  if (marked)
+    spdlog::warn("{}: {} cell(s) hold a NODATA marker the header does not declare (its NODATA_value is {}), taken as "
+                 "NODATA: {}{}",
+                 file.string(), marked, grid.nodata, fmt::join(markers, "; "), marked > markers.size() ? "; ..." : "");
+  require_some_data(grid, file);
+  check_heights(grid, file);
+
+  // d: each cell's distance to the median of its valid neighbours (cells with fewer than three are
+  // not judged). A spike is far off beyond the grid's own roughness and beyond its neighbours'.
+  std::vector<double> median(n, 0.0), off(n, 0.0);
+  std::vector<char> judged(n, 0);
+  std::vector<double> around;
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t c = 0; c < cols; ++c) {
+      const std::size_t i = r * cols + c;
+      if (!grid.valid(r, c)) continue;
+      around.clear();
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc) {
+          const long rr = long(r) + dr, cc = long(c) + dc;
+          if ((dr || dc) && rr >= 0 && cc >= 0 && rr < long(rows) && cc < long(cols) && grid.valid(std::size_t(rr), std::size_t(cc)))
+            around.push_back(grid.at(std::size_t(rr), std::size_t(cc)));
+        }
+      if (around.size() < 3) continue;
+      std::nth_element(around.begin(), around.begin() + std::ptrdiff_t(around.size() / 2), around.end());
+      median[i] = around[around.size() / 2];
+      off[i] = std::abs(grid.heights[i] - median[i]);
+      judged[i] = 1;
+    }
+  std::vector<double> offs;
+  for (std::size_t i = 0; i < n; ++i)
+    if (judged[i]) offs.push_back(off[i]);
+  if (offs.empty()) return;
+  std::nth_element(offs.begin(), offs.begin() + std::ptrdiff_t(offs.size() / 2), offs.end());
+  const double roughness = 1.4826 * offs[offs.size() / 2];
+  const double threshold = std::max(30 * roughness, 3 * grid.cell_size);
+  std::vector<std::string> spikes;
+  std::size_t despiked = 0;
+  for (std::size_t r = 0; r < rows; ++r)
+    for (std::size_t c = 0; c < cols; ++c) {
+      const std::size_t i = r * cols + c;
+      if (!judged[i] || !(off[i] > threshold)) continue;
+      double neighbours = 0;  // the largest d around: a cliff's cells are all far off, a spike alone
+      for (int dr = -1; dr <= 1; ++dr)
+        for (int dc = -1; dc <= 1; ++dc) {
+          const long rr = long(r) + dr, cc = long(c) + dc;
+          if ((dr || dc) && rr >= 0 && cc >= 0 && rr < long(rows) && cc < long(cols))
+            neighbours = std::max(neighbours, off[std::size_t(rr) * cols + std::size_t(cc)]);
+        }
+      if (!(off[i] > 5 * neighbours)) continue;
+      if (spikes.size() < 5)
+        spikes.push_back(fmt::format("row {}, column {}: {} -> {}", r + 1, c + 1, grid.heights[i], median[i]));
+      grid.heights[i] = median[i];
+      ++despiked;
+    }
+  if (despiked)
+    spdlog::warn("{}: {} cell(s) stand alone {:.3g} or more off the median of their neighbours (more than 30 times "
+                 "the grid's roughness and 3 cells' size, and 5 times any neighbour's), taken as damaged and given "
+                 "that median: {}{}",
+                 file.string(), despiked, threshold, fmt::join(spikes, "; "), despiked > spikes.size() ? "; ..." : "");
 }
 
 std::string lower(std::string s) {
@@ -263,7 +344,7 @@ HeightGrid read_dem_as_is(const std::filesystem::path& file) {
   if (ext == ".tif" || ext == ".tiff") return read_geotiff(file);
   if (ext == ".lcp") {
     HeightGrid grid = read_landscape_band_as_is(file, LandscapeBand::elevation);
-    check_heights(grid, file);
+    screen_heights(grid, file);
     return grid;
   }
   throw file_error(file, "unknown DEM format: expected .asc (ESRI ASCII grid), .tif/.tiff (GeoTIFF) or .lcp (a "
@@ -367,7 +448,7 @@ HeightGrid read_esri_ascii_values(const std::filesystem::path& file) {
 HeightGrid read_esri_ascii(const std::filesystem::path& file) {
   HeightGrid grid = read_esri_ascii_values(file);
   require_some_data(grid, file);
-  check_heights(grid, file);
+  screen_heights(grid, file);
   return grid;
 }
 
@@ -397,7 +478,7 @@ HeightGrid read_geotiff(const std::filesystem::path& file) {
   std::string error;
   if (!gis.read_raster(file, grid, error)) throw file_error(file, error);
   require_some_data(grid, file);
-  check_heights(grid, file);
+  screen_heights(grid, file);
   return grid;
 }
 

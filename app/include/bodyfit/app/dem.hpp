@@ -55,7 +55,10 @@ struct DemReadOptions {
 };
 
 /// ESRI ASCII grid (.asc) as a terrain: NODATA kept, some data and plausible heights required.
-/// Errors name the file and line.
+/// Errors name the file and line. As for every DEM read (GeoTIFF and landscape too), a cell holding
+/// a common NODATA marker its header does not declare (−9999, −32768, −3.4e38…) is NODATA, and a
+/// cell standing alone far off its neighbours (a spike or a pit) takes their median: both with a
+/// warning naming the cells.
 HeightGrid read_esri_ascii(const std::filesystem::path& file);
 /// The values of an ESRI ASCII grid as they are (NODATA as grid.nodata), without a terrain's checks: for rasters
 /// of results such as arrival times, where NODATA means "never reached", not a missing height.
