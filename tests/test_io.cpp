@@ -1311,3 +1311,17 @@ TEST_CASE("polygons of any shape: concave and star-shaped caps keep their area i
   write_text(dir / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3 4\n");
   CHECK_THROWS_WITH_AS(read_mesh(dir / "flat.obj"), doctest::Contains("has no area"), InputError);
 }
+
+TEST_CASE("a vertex written twice is merged into the first: the surface comes back closed, its vertices renumbered") {
+  TempDir dir("io-duplicates");
+  // A tetrahedron whose first corner is written again as vertex 5 and used by one face (a closed
+  // surface cut open along that face's two edges, as CAD exports and CGAL's examples have them).
+  write_text(dir / "dup.off", "OFF\n5 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 0 0\n3 0 2 1\n3 4 1 3\n3 1 2 3\n3 0 3 2\n");
+  const SurfaceMesh mesh = read_mesh(dir / "dup.off");
+  CHECK(mesh.n_vertices() == 4);
+  CHECK(mesh.n_faces() == 4);
+  std::size_t boundary = 0;
+  for (auto e : mesh.edges()) boundary += mesh.is_boundary(e);
+  CHECK(boundary == 0);
+  CHECK(enclosed_volume(mesh) == doctest::Approx(1.0 / 6.0).epsilon(1e-12));
+}

@@ -6,8 +6,10 @@
 #include <bodyfit/io.hpp>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <numeric>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -173,6 +175,44 @@ class SilenceOpenMeshErrors {
 
 }  // namespace
 
+/// The records with every set of vertices at one point made one (the first of each, in order),
+/// the others dropped and the indices renumbered; `merged` counts the dropped ones. Locators are
+/// not kept (what is built from it names no line).
+MeshRecords merge_coincident_vertices(const MeshRecords& r, std::size_t& merged) {
+  const std::size_t n = r.points.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  auto coordinates = [&](std::size_t i) { return std::array<double, 3>{r.points[i][0], r.points[i][1], r.points[i][2]}; };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return coordinates(a) < coordinates(b); });
+  std::vector<std::size_t> first(n);
+  for (std::size_t k = 0; k < n; ++k)
+    first[order[k]] = k > 0 && coordinates(order[k]) == coordinates(order[k - 1]) ? first[order[k - 1]] : order[k];
+  MeshRecords out;
+  out.vertex_at = out.triangle_at = out.edge_at = Locator::none();
+  out.corner_at = out.required_vertex_at = out.ridge_at = out.required_edge_at = Locator::none();
+  std::vector<std::int64_t> index(n, -1);
+  merged = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (first[i] != i) {
+      ++merged;
+      continue;
+    }
+    index[i] = std::int64_t(out.points.size());
+    out.points.push_back(r.points[i]);
+    if (i < r.vertex_refs.size()) out.vertex_refs.push_back(r.vertex_refs[i]);
+  }
+  auto renumbered = [&](std::int64_t i) { return index[first[std::size_t(i)]]; };
+  for (const auto& t : r.triangles) out.triangles.push_back({renumbered(t[0]), renumbered(t[1]), renumbered(t[2])});
+  out.triangle_refs = r.triangle_refs;
+  for (const auto& e : r.edges) out.edges.push_back({renumbered(e[0]), renumbered(e[1])});
+  out.edge_refs = r.edge_refs;
+  for (auto v : r.corners) out.corners.push_back(renumbered(v));
+  for (auto v : r.required_vertices) out.required_vertices.push_back(renumbered(v));
+  out.ridges = r.ridges;
+  out.required_edges = r.required_edges;
+  return out;
+}
+
 SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const ReadOptions& options) {
   const std::int64_t nv = static_cast<std::int64_t>(r.points.size());
   for (std::size_t i = 0; i < r.points.size(); ++i) {
@@ -328,7 +368,10 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   }
   // Two boundary vertices at the same point: a vertex written twice, which cuts a closed surface
   // open along the faces that use the copy (a boundary where there is none). Boundary vertices only:
-  // they are few, and a duplicate that opens nothing cannot lie anywhere else.
+  // they are few, and a duplicate that opens nothing cannot lie anywhere else. MMG and CGAL take such
+  // files: every set of vertices at one point is merged and the surface built again, with a warning
+  // (the vertices are renumbered); when that does not give a valid surface either, the duplicate is
+  // the error.
   {
     std::vector<int> boundary;
     for (auto v : mesh.vertices())
@@ -342,10 +385,22 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
       const int a = boundary[k - 1], b = boundary[k];
       if (mesh.point(VertexHandle(a)) != mesh.point(VertexHandle(b))) continue;
       const Vec3& p = mesh.point(VertexHandle(b));
-      throw r.vertex_at.error(file, std::size_t(b),
-                              fmt::format("vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on "
-                                          "a boundary: a duplicated vertex cuts the surface open there; merge them",
-                                          a + 1, b + 1, p[0], p[1], p[2]));
+      const InputError duplicate = r.vertex_at.error(
+          file, std::size_t(b),
+          fmt::format("vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on a boundary: a "
+                      "duplicated vertex cuts the surface open there; merge them",
+                      a + 1, b + 1, p[0], p[1], p[2]));
+      std::size_t merged = 0;
+      MeshRecords joined = merge_coincident_vertices(r, merged);
+      try {
+        SurfaceMesh whole = build_mesh(std::move(joined), file, options);
+        spdlog::warn("{}: {} vertices at the same point as an earlier one (vertex {} is vertex {}, ...) merged, as MMG "
+                     "and CGAL do: the surface is closed there, and its vertices are renumbered",
+                     file.string(), merged, b + 1, a + 1);
+        return whole;
+      } catch (const InputError&) {
+        throw duplicate;
+      }
     }
   }
   return mesh;
