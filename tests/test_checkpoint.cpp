@@ -15,6 +15,7 @@
 #include <doctest/doctest.h>
 
 #include <cstring>
+#include <limits>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -174,6 +175,14 @@ TEST_CASE("damaged, truncated and altered checkpoints are refused before anythin
   next = (next + 7) % std::int32_t(mesh.n_halfedges());
   std::memcpy(wrong_next.data() + next_at, &next, 4);
   CHECK(error_of(wrong_next).find("corrupt checkpoint") != std::string::npos);
+
+  // Intact checksums over impossible content: refused as corrupt, not met later as an overflow or a
+  // NaN time.
+  CHECK(error_of(bytes_of(mesh, {.iteration = std::numeric_limits<int>::max(), .time = 0.5}, nullptr))
+            .find("corrupt checkpoint: iteration 2147483647") != std::string::npos);
+  CHECK(error_of(bytes_of(mesh, {.iteration = -3, .time = 0.5}, nullptr)).find("iteration -3") != std::string::npos);
+  CHECK(error_of(bytes_of(mesh, {.iteration = 2, .time = std::nan("")}, nullptr)).find("time nan") != std::string::npos);
+  CHECK(error_of(bytes_of(mesh, {.iteration = 2, .time = 1, .dt = -1}, nullptr)).find("step -1") != std::string::npos);
 }
 
 TEST_CASE("format 2 checkpoints (before the model state) and format 1 still load") {

@@ -5,6 +5,10 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
+#include <limits>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
@@ -323,9 +327,18 @@ Checkpoint decode_checkpoint(const std::string& data, const std::string& name) {
     if (data.size() < 16 || stored != checksum(data.data(), data.size() - 8))
       throw InputError(fmt::format("{}: corrupt checkpoint: checksum mismatch (the file is damaged or truncated)", name));
   }
-  c.run.iteration = int(in.get<std::int64_t>());
+  const auto iteration = in.get<std::int64_t>();
   c.run.time = in.get<double>();
   if (c.format >= 3) c.run.dt = in.get<double>();
+  // An intact checksum over content no run can have written (another program's, a hand-made file)
+  // is refused here, not met as an overflow or a NaN time steps later.
+  if (iteration < 0 || iteration >= std::numeric_limits<int>::max() - 1)
+    throw InputError(fmt::format("{}: corrupt checkpoint: iteration {} (expected 0 to {})", name, iteration,
+                                 std::numeric_limits<int>::max() - 2));
+  if (!std::isfinite(c.run.time) || !std::isfinite(c.run.dt) || c.run.dt < 0)
+    throw InputError(fmt::format("{}: corrupt checkpoint: time {} and step {} (expected finite, the step ≥ 0)", name,
+                                 c.run.time, c.run.dt));
+  c.run.iteration = int(iteration);
   const auto nv = in.get<std::uint64_t>();
   const auto ne = c.format >= 2 ? in.get<std::uint64_t>() : 0;
   const auto nf = in.get<std::uint64_t>();
