@@ -176,6 +176,9 @@ TEST_CASE("wind series errors name the file and the line") {
   CHECK(error_of("time,u,v\n0,1,1\n5,1x,1\n") == at + ":3: u: '1x' is not a number");
   CHECK(error_of("time,u,v\n0,1\n") == at + ":2: 2 field(s), the header has 3 (time,u,v)");
   CHECK(error_of("time,speed,direction_deg\n0,-1,90\n") == at + ":2: speed: -1 is negative (m/s, expected ≥ 0)");
+  // Beyond any wind near the ground: a unit mistake (km/h for m/s) or a damaged value.
+  CHECK(error_of("time,speed,direction_deg\n0,10,90\n60,360,90\n").starts_with(at + ":3: a wind of 360 m/s is beyond 150"));
+  CHECK(error_of("time,u,v\n0,1e300,0\n").starts_with(at + ":2: a wind of 1e+300 m/s"));
   CHECK(error_of("time,u,v\nnoon,1,1\n").starts_with(at + ":2: time: 'noon' is neither a number"));
   CHECK(error_of("time,u,v\n0,1,1\n2026-07-14T13:00:00Z,1,1\n").starts_with(at + ":3: time: '2026-07-14T13:00:00Z' is a date-time"));
   CHECK(error_of("time,u,v\n") == at + ":1: no row after the header (expected time,speed,direction_deg or time,u,v)");
@@ -183,6 +186,10 @@ TEST_CASE("wind series errors name the file and the line") {
   CHECK(error_of("time,u,u\n").starts_with(at + ":1: the header 'time,u,u' has an empty or repeated column"));
   // The case's keys: a series needs its file, which only a series takes.
   LoadedModel model = load_plugin_file(fs::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");
+  CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nspeed = 1e300\ndirection_deg = 0\n")),
+                       doctest::Contains("[model.wind] speed: a wind of 1e+300 m/s is beyond 150 m/s"), InputError);
+  CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nvelocity = [200.0, 0.0]\n")),
+                       doctest::Contains("velocity: a wind of 200 m/s"), InputError);
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'series'\n")),
                        doctest::Contains("type = \"series\" needs file"), InputError);
   CHECK_THROWS_WITH_AS(configure_model(model, toml::parse("[wind]\ntype = 'uniform'\nfile = 'w.csv'\n")),

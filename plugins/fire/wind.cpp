@@ -35,6 +35,16 @@ bool same_frame(const HeightGrid& a, const HeightGrid& b) {
          a.cell_size == b.cell_size;
 }
 
+// Winds beyond this are not winds near the ground (the strongest measured, 113 m/s, in a cyclone):
+// a unit mistake (km/h, knots, cm/s) or a damaged value, refused where it is read.
+constexpr double kMaxWind = 150;
+
+std::string too_strong(double speed) {
+  return fmt::format("a wind of {:.4g} m/s is beyond {} m/s (the strongest measured near the ground is 113 m/s): "
+                     "a unit mistake (km/h? knots?) or a damaged value",
+                     speed, kMaxWind);
+}
+
 /// A wind raster: its NODATA cells take the nearest valid value (a wind field has no holes).
 HeightGrid read_wind_raster(const std::filesystem::path& file, const RasterReader& read) {
   HeightGrid grid = read ? read(file) : read_dem(file);
@@ -62,6 +72,8 @@ WindSeries read_wind_series(const std::filesystem::path& file) {
       if (speed < 0) throw file_error(file, row.line, fmt::format("speed: {} is negative (m/s, expected ≥ 0)", speed));
       series.uniform.push_back(wind_from_direction(speed, finite_number(csv, row, "direction_deg")));
     }
+    const double speed = std::hypot(series.uniform.back()[0], series.uniform.back()[1]);  // no overflow at 1e300
+    if (speed > kMaxWind) throw file_error(file, row.line, too_strong(speed));
   }
   return series;
 }
@@ -175,9 +187,11 @@ WindField read_wind_table(Parameters& w, const RasterReader& read) {
       if (w.has("velocity")) w.fail("velocity", "give either velocity or speed and direction_deg");
       const double speed = w.required_number("speed");
       wind.uniform = wind_from_direction(speed, w.required_number("direction_deg"));
+      if (speed > kMaxWind) w.fail("speed", too_strong(speed));
     } else {
       const auto velocity = w.numbers("velocity");
       wind.uniform = Vec3(velocity[0], velocity[1], 0);
+      if (const double speed = std::hypot(velocity[0], velocity[1]); speed > kMaxWind) w.fail("velocity", too_strong(speed));
     }
   } else {
     for (const char* key : {"velocity", "speed", "direction_deg"}) applies_to(key, "\"uniform\"");
@@ -199,6 +213,12 @@ WindField read_wind_table(Parameters& w, const RasterReader& read) {
     wind.v_file = w.path("v_file");
     wind.u = read_wind_raster(wind.u_file, read);
     wind.v = read_wind_raster(wind.v_file, read);
+    if (wind.u.heights.size() == wind.v.heights.size())
+      for (std::size_t i = 0; i < wind.u.heights.size(); ++i)
+        if (const double speed = std::hypot(wind.u.heights[i], wind.v.heights[i]); speed > kMaxWind)
+          throw InputError(fmt::format("{} and {}: the cell at row {}, column {}: {}", wind.u_file.string(),
+                                       wind.v_file.string(), i / wind.u.cols + 1, i % wind.u.cols + 1,
+                                       too_strong(speed)));
   } else {
     for (const char* key : {"u_file", "v_file"}) applies_to(key, "\"grid\"");
   }
