@@ -614,3 +614,55 @@ TEST_CASE("GIS outputs of a run: arrival time and rate of spread as GeoTIFF, per
   const double final_area = region_plan_area(final_mesh);
   CHECK(std::abs(previous - final_area) <= 1e-9 * final_area);
 }
+
+TEST_CASE("a raster of another place (a fuel map 200 km off the DEM) is refused, one covering part of it is said") {
+  test::TempDir dir("fire_far_map");
+  const std::filesystem::path dem = test::source_path("meshes/dem/luxembourg_elev_200m.asc");
+  const std::string fuel = test::read_file(test::source_path("meshes/dem/luxembourg_fuel_200m.asc"));
+  const std::string prj = test::read_file(test::source_path("meshes/dem/luxembourg_fuel_200m.prj"));
+  auto shifted = [&](const std::string& name, double dx) {
+    std::string text = fuel;
+    const std::string key = "xllcorner    263811.219768329640";
+    REQUIRE(text.find(key) != std::string::npos);
+    text.replace(text.find(key), key.size(), fmt::format("xllcorner    {:.6f}", 263811.219768329640 + dx));
+    std::ofstream(dir / (name + ".asc")) << text;
+    std::ofstream(dir / (name + ".prj")) << prj;
+  };
+  shifted("far", 200000);
+  shifted("half", 30000);
+  const std::string case_text = fmt::format(R"([surface]
+generator = "terrain"
+dem = "{}"
+h = 800.0
+[region]
+shape = "disks"
+centers = [[288818.0, 5548359.0]]
+radii = [2000.0]
+[model]
+name = "fire"
+preset = "balbi2009"
+[model.fuel]
+map = "MAP"
+presets = ["balbi2009"]
+[time]
+dt = 600.0
+iterations = 1
+[output]
+vtu_every = 0
+)", dem.string());
+  for (const char* map : {"far", "half"}) {
+    CAPTURE(map);
+    std::string text = case_text;
+    text.replace(text.find("MAP"), 3, (dir / (std::string(map) + ".asc")).string());
+    std::ofstream(dir / "case.toml") << text;
+    auto run = test::run_bodyfit("run " + (dir / "case.toml").string() + " -o " + (dir / map).string());
+    if (std::string(map) == "far") {
+      CHECK_MESSAGE(run.exit_code == 1, run.output);
+      CHECK(run.output.find("far.asc: its extent x 463811.2..524011.2") != std::string::npos);
+      CHECK(run.output.find("do not overlap: the raster is of another place") != std::string::npos);
+    } else {
+      CHECK_MESSAGE(run.exit_code == 0, run.output);
+      CHECK(run.output.find("% of the terrain; beyond it, points take its nearest edge cell") != std::string::npos);
+    }
+  }
+}

@@ -299,6 +299,7 @@ class FireModel final : public VelocityModel {
     if (arrival_like_.cols > 0) rasters.emplace_back(&arrival_like_, arrival_like_file_);
     if (rothermel_)
       for (const auto& raster : rothermel_spread_.rasters()) rasters.push_back(raster);
+    rasters_ = rasters;
     crs_ = surface_.crs;
     const HeightGrid* first = nullptr;
     std::filesystem::path first_file;
@@ -313,6 +314,32 @@ class FireModel final : public VelocityModel {
     }
   }
 
+  /// Every raster of the model covers the terrain: outside its extent a point takes the nearest edge
+  /// cell, so a map of another place (a fuel map 200 km off) would be read without a word. None of
+  /// the terrain covered is an error; less than 90 % a warning.
+  void check_raster_extents(const BoundingBox& terrain) {
+    extents_checked_ = true;
+    const double dx = terrain.max[0] - terrain.min[0], dy = terrain.max[1] - terrain.min[1];
+    if (!(dx > 0 && dy > 0)) return;
+    for (const auto& [grid, file] : rasters_) {
+      const double x0 = grid->x_origin, x1 = x0 + double(grid->cols) * grid->cell_size;
+      const double y0 = grid->y_origin, y1 = y0 + double(grid->rows) * grid->cell_size;
+      const double wx = std::min(x1, terrain.max[0]) - std::max(x0, terrain.min[0]);
+      const double wy = std::min(y1, terrain.max[1]) - std::max(y0, terrain.min[1]);
+      const double covered = wx > 0 && wy > 0 ? wx * wy / (dx * dy) : 0.0;
+      const std::string where = fmt::format("{}: its extent x {:.1f}..{:.1f}, y {:.1f}..{:.1f} and the terrain's x "
+                                            "{:.1f}..{:.1f}, y {:.1f}..{:.1f}",
+                                            file.string(), x0, x1, y0, y1, terrain.min[0], terrain.max[0],
+                                            terrain.min[1], terrain.max[1]);
+      if (covered == 0)
+        throw InputError(fmt::format("{} do not overlap: the raster is of another place (or in other coordinates)",
+                                     where));
+      if (covered < 0.9)
+        spdlog::warn("{}: it covers {:.0f} % of the terrain; beyond it, points take its nearest edge cell", where,
+                     100 * covered);
+    }
+  }
+
   VelocityField compute(const StepContext& context) override {
     const SurfaceMesh& mesh = context.mesh();
     const VectorField& conormal = context.conormal();
@@ -320,6 +347,7 @@ class FireModel final : public VelocityModel {
     // The remeshed T^n's vertex normals average other faces at every step, and the front picked up
     // that noise in R (docs/reference/fire_model.md, "Slope from the surface").
     const VectorField& normals = surface_slope_ ? context.surface_normals() : context.vertex_normals();
+    if (!extents_checked_) check_raster_extents(bounding_box(mesh));
     if (!wind_.has_center) {
       BoundingBox box = bounding_box(mesh);
       wind_.center = 0.5 * (box.min + box.max);
@@ -656,6 +684,8 @@ class FireModel final : public VelocityModel {
   double arrival_cell_ = 0;
   HeightGrid arrival_like_;
   std::string crs_;
+  std::vector<std::pair<const HeightGrid*, std::filesystem::path>> rasters_;  ///< the model's rasters (configure)
+  bool extents_checked_ = false;  ///< they cover the terrain (on the first compute)
   std::filesystem::path fuel_file_, arrival_like_file_;  ///< the coordinate system of the model's rasters (WKT; "" when none says), for its outputs
   ArrivalRaster arrival_;
   bool huygens_ = true;  ///< front_velocity: V = R n + (dR/dθ) t (true) or R n (the paper's)
