@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <fstream>
 
@@ -625,4 +626,45 @@ TEST_CASE("a file-size limit (ulimit -f): an I/O error naming it, exit 6, and no
   CHECK_MESSAGE(output.ends_with("\n6\n"), output);
   CHECK_MESSAGE(contains(output, "write failed (File too large)"), output);
   for (const auto& name : names_in(out)) CHECK_FALSE(is_atomic_temporary(name));
+}
+
+TEST_CASE("a model stuck in compute under a --model-timeout ends the run on its own, exit 4, the checkpoint intact") {
+  test::TempDir dir("faults_timeout");
+  const fs::path hang = dir / "hang";
+  std::ofstream(hang) << "stuck while this file exists\n";
+  const fs::path file = dir / "case.toml";
+  std::ofstream(file) << fmt::format(R"(
+[surface]
+generator = "plane"
+size = 2.0
+h = 0.1
+[region]
+shape = "disks"
+centers = [[0.0, 0.0]]
+radii = [0.3]
+[model]
+name = "testlifecycle"
+speed = 0.5
+hang_file = "{}"
+[time]
+dt = 0.05
+iterations = 4
+[output]
+vtu_every = 0
+png_every = 0
+)", hang.string());
+  ::setenv("BODYFIT_PLUGIN_PATH", BODYFIT_TEST_PLUGIN_DIR, 1);
+  const fs::path out = dir / "out";
+  const auto started = std::chrono::steady_clock::now();
+  auto stuck = test::run_bodyfit("run " + file.string() + " -o " + out.string() + " --model-timeout 1");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  CHECK_MESSAGE(stuck.exit_code == 4, stuck.output);
+  CHECK(contains(stuck.output, "model 'testlifecycle' did not return from compute at iteration"));
+  CHECK(contains(stuck.output, "within the limit (--model-timeout 1 s)"));
+  CHECK(seconds < 30);
+  CHECK(load_checkpoint(out / "checkpoint.bin").run.iteration == 0);
+  fs::remove(hang);
+  auto rest = test::run_bodyfit("run " + file.string() + " -o " + out.string() + " --resume --force --model-timeout 60");
+  REQUIRE_MESSAGE(rest.exit_code == 0, rest.output);
+  CHECK(fs::exists(out / "final.mesh"));
 }

@@ -1,5 +1,6 @@
 // bodyfit run case.toml: the whole evolution (Algorithm 1) with its outputs (docs/reference/running.md).
 #include "commands.hpp"
+#include "validators.hpp"
 
 #include <bodyfit/app/case_config.hpp>
 #include <bodyfit/app/case_identity.hpp>
@@ -12,6 +13,7 @@
 #include <bodyfit/checkpoint.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/fault_injection.hpp>
+#include <bodyfit/model_guard.hpp>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -52,6 +54,7 @@ struct RunArguments {
   std::string inject_io_error;  ///< "POINT:N": an IoError there instead
   std::string inject_signal;  ///< "N:INT" or "N:KILL" [":scheduled"]: raise a signal after iteration N (tests)
   bool verbose = false;       ///< the stage times on every progress line
+  double model_timeout = 0;   ///< seconds a call into the model may take (0: no limit)
 };
 
 /// A directory holding a previous run is not written into by accident. (Temporaries alone are
@@ -127,6 +130,7 @@ int run_case(const RunArguments& args) {
   // shell started us with SIGINT ignored (background jobs).
   for (int signal : {SIGINT, SIGTERM, SIGHUP}) std::signal(signal, on_run_signal);
   const InjectedSignal inject = parse_injected_signal(args.inject_signal);
+  limit_model_calls(args.model_timeout);
   if (!args.inject_fault.empty()) arm_fault(args.inject_fault);
   if (!args.inject_io_error.empty()) arm_fault(args.inject_io_error, FaultKind::IoError);
 
@@ -235,6 +239,11 @@ bodyfit::cli::Command setup_run(CLI::App& app) {
   cmd->add_flag("--force", args->force, "with --resume: continue even though the case differs from the checkpoint's")
       ->needs(resume);
   cmd->add_flag("--verbose", args->verbose, "the milliseconds of each stage on every iteration's line");
+  cmd->add_option("--model-timeout", args->model_timeout,
+                  "end the run (exit 4, the last checkpoint intact) when a call into the model takes longer than this "
+                  "many seconds (0: no limit)")
+      ->check(bodyfit::cli::finite_at_least(0))
+      ->capture_default_str();
   // Test hooks (no group: hidden from --help): a crash or Ctrl-C at a known point of the run.
   cmd->add_option("--inject-signal", args->inject_signal, "")->group("");
   cmd->add_option("--inject-fault", args->inject_fault, "")->group("");

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
+#include <thread>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
@@ -21,6 +24,13 @@ namespace {
 char g_model[128] = "?";
 std::atomic<const char*> g_stage{nullptr};
 std::atomic<int> g_iteration{-1};
+std::atomic<std::int64_t> g_started{0};     // steady-clock ns at the start of the current call
+std::atomic<std::int64_t> g_limit_ns{0};    // limit_model_calls (0: none)
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 
 void put(char*& at, const char* end, const char* text) {
   while (*text && at < end) *at++ = *text++;
@@ -125,7 +135,39 @@ void report_model_crashes(const std::string& name) {
 
 PluginCall::PluginCall(const char* stage, int iteration) {
   g_iteration.store(iteration);
+  g_started.store(now_ns());
   g_stage.store(stage);
+}
+
+void limit_model_calls(double seconds) {
+  g_limit_ns.store(seconds > 0 ? std::int64_t(seconds * 1e9) : 0);
+  if (!(seconds > 0)) return;
+  static const bool started = [] {
+    std::thread([] {
+      for (;;) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        const std::int64_t limit = g_limit_ns.load();
+        const char* stage = g_stage.load();
+        if (!limit || !stage || now_ns() - g_started.load() <= limit) continue;
+        char message[512];
+        char* at = message;
+        const char* end = message + sizeof message - 1;
+        put(at, end, "bodyfit: model '");
+        put(at, end, g_model);
+        put(at, end, "' did not return from ");
+        put(at, end, stage);
+        const int iteration = g_iteration.load();
+        if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
+        put(at, end, " within the limit (--model-timeout ");
+        put_int(at, end, int(limit / 1000000000));
+        put(at, end, " s): a model failure; the checkpoint on disk is intact: --resume continues from it\n");
+        [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+        ::_exit(int(ExitCode::Plugin));
+      }
+    }).detach();
+    return true;
+  }();
+  (void)started;
 }
 
 PluginCall::~PluginCall() { g_stage.store(nullptr); }

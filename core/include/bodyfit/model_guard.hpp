@@ -28,6 +28,12 @@ namespace bodyfit {
 /// Install the crash report (once per process) for the model `name`.
 void report_model_crashes(const std::string& name);
 
+/// A call into the model that has not returned after `seconds` ends the process with exit code 4
+/// and a report naming the model, the stage and the iteration (the last checkpoint on disk is
+/// intact): a model stuck in a loop or waiting forever stops on its own under a batch scheduler.
+/// A watchdog thread, started by the first call; 0 turns the limit off.
+void limit_model_calls(double seconds);
+
 /// Marks a call into the plugin for the crash report while it lives (GuardedModel uses it; the
 /// driver around configure_model). Not nested.
 class PluginCall {
