@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <initializer_list>
 #include <cstdint>
 #include <thread>
 #include <chrono>
@@ -57,25 +58,32 @@ const char* signal_name(int signal) {
   return "a signal";
 }
 
+/// "bodyfit: model 'M' <what…> <stage> at iteration N<middle><number><tail>; the checkpoint on disk is
+/// intact…" on stderr, with write(2) alone: it is called from signal handlers, atexit and the
+/// watchdog.
+void report_call(const char* stage, std::initializer_list<const char*> what, const char* middle = "", int number = -1,
+                 const char* tail = "") {
+  char message[512];
+  char* at = message;
+  const char* end = message + sizeof message - 1;
+  put(at, end, "bodyfit: model '");
+  put(at, end, g_model);
+  put(at, end, "' ");
+  for (const char* words : what) put(at, end, words);
+  put(at, end, stage);
+  const int iteration = g_iteration.load();
+  if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
+  put(at, end, middle);
+  if (number >= 0) put_int(at, end, number);
+  put(at, end, tail);
+  put(at, end, iteration >= 0 ? "; the checkpoint on disk is intact: --resume continues from it\n"
+                              : "; before the run wrote anything\n");
+  [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+}
+
 extern "C" void on_crash(int signal) {
   // SA_RESETHAND: the default action is back; re-raised below, the process dies of the signal.
-  const char* stage = g_stage.load();
-  if (stage) {
-    char message[512];
-    char* at = message;
-    const char* end = message + sizeof message - 1;
-    put(at, end, "bodyfit: model '");
-    put(at, end, g_model);
-    put(at, end, "' crashed (");
-    put(at, end, signal_name(signal));
-    put(at, end, ") in ");
-    put(at, end, stage);
-    const int iteration = g_iteration.load();
-    if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
-    put(at, end, iteration >= 0 ? "; the checkpoint on disk is intact: --resume continues from it\n"
-                                : "; before the run wrote anything\n");
-    [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
-  }
+  if (const char* stage = g_stage.load()) report_call(stage, {"crashed (", signal_name(signal), ") in "});
   std::raise(signal);  // a raised (not faulting) signal would otherwise return here
 }
 
@@ -84,18 +92,7 @@ extern "C" void on_crash(int signal) {
 extern "C" void on_exit_in_model() {
   const char* stage = g_stage.load();
   if (!stage) return;
-  char message[512];
-  char* at = message;
-  const char* end = message + sizeof message - 1;
-  put(at, end, "bodyfit: model '");
-  put(at, end, g_model);
-  put(at, end, "' called exit() in ");
-  put(at, end, stage);
-  const int iteration = g_iteration.load();
-  if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
-  put(at, end, iteration >= 0 ? ": a model failure; the checkpoint on disk is intact: --resume continues from it\n"
-                              : ": a model failure, before the run wrote anything\n");
-  [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+  report_call(stage, {"called exit() in "}, ": a model failure");
   ::_exit(int(ExitCode::Plugin));
 }
 
@@ -149,19 +146,8 @@ void limit_model_calls(double seconds) {
         const std::int64_t limit = g_limit_ns.load();
         const char* stage = g_stage.load();
         if (!limit || !stage || now_ns() - g_started.load() <= limit) continue;
-        char message[512];
-        char* at = message;
-        const char* end = message + sizeof message - 1;
-        put(at, end, "bodyfit: model '");
-        put(at, end, g_model);
-        put(at, end, "' did not return from ");
-        put(at, end, stage);
-        const int iteration = g_iteration.load();
-        if (iteration >= 0) put(at, end, " at iteration "), put_int(at, end, iteration);
-        put(at, end, " within the limit (--model-timeout ");
-        put_int(at, end, int(limit / 1000000000));
-        put(at, end, " s): a model failure; the checkpoint on disk is intact: --resume continues from it\n");
-        [[maybe_unused]] auto written = ::write(STDERR_FILENO, message, std::size_t(at - message));
+        report_call(stage, {"did not return from "}, " within the limit (--model-timeout ", int(limit / 1000000000),
+                    " s): a model failure");
         ::_exit(int(ExitCode::Plugin));
       }
     }).detach();
