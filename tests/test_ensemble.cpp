@@ -531,3 +531,24 @@ live_woody = 90.0
   const auto [lo, hi] = std::minmax_element(sampled.begin(), sampled.end());
   CHECK(*hi > 1.2 * *lo);
 }
+
+TEST_CASE("ensemble: members whose grids differ stop the ensemble as soon as two have finished, naming both") {
+  TempDir dir("ensemble_grids_differ");
+  // The arrival grid's cell size sampled: every member's grid has other cells. Two threads run the
+  // members; the second to finish stops them, long before the 40 members ran.
+  std::string text = kCase;
+  const std::string sample = "\"model.R0\" = {dist = \"lognormal\", mu = -0.92, sigma = 0.2}";
+  text.replace(text.find(sample), sample.size(),
+               sample + "\n\"model.arrival.cell_size\" = {dist = \"uniform\", min = 40, max = 60}");
+  const fs::path case_file = write_case(dir, text);
+  const auto result = run_bodyfit(
+      fmt::format("--threads 2 ensemble {} -o {} --members 40 --jobs 2", case_file.string(), (dir / "out").string()));
+  INFO(result.output);
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("their 'arrival_time' grids differ") != std::string::npos);
+  CHECK(result.output.find("the grid depends on a sampled parameter") != std::string::npos);
+  std::size_t grids = 0;  // written by the members that finished with the first one's frame
+  for (const auto& entry : fs::directory_iterator(dir / "out" / "members"))
+    grids += entry.path().filename().string().find("arrival_time") != std::string::npos;
+  CHECK(grids < 10);
+}

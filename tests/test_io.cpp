@@ -1289,9 +1289,10 @@ TEST_CASE("polygons of any shape: concave and star-shaped caps keep their area i
       for (int c : f) ply += fmt::format(" {}", c);
       ply += "\n";
     }
-    for (const auto& [name, text] : {std::pair{"star.obj", obj}, std::pair{"star.off", off}, std::pair{"star.ply", ply}}) {
+    for (const auto& file : {std::pair{"star.obj", obj}, std::pair{"star.off", off}, std::pair{"star.ply", ply}}) {
+      const std::string name = file.first;  // not a structured binding: CAPTURE (clang 14)
       CAPTURE(name);
-      write_text(dir / name, text);
+      write_text(dir / name, file.second);
       const SurfaceMesh mesh = read_mesh(dir / name);
       CHECK(mesh.n_faces() == std::size_t(2 * (n - 2) + 2 * n));  // n − 2 triangles per cap
       CHECK(total_area(mesh) == doctest::Approx(2 * area + perimeter * height).epsilon(1e-12));

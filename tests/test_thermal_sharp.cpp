@@ -127,7 +127,10 @@ TEST_CASE("topological sensitivity: a small disk of G inserted where 4 gamma u p
     SharpSolution solution = solve_sharp(v, {}, g);
     return std::tuple{std::move(s), std::move(phi), std::move(solution)};
   };
-  const auto [s, d, before] = solve(0);
+  const auto start = solve(0);  // not a structured binding: clang 14 refuses them in doctest's lambdas
+  const SurfaceMesh& s = std::get<0>(start);
+  const std::vector<double>& d = std::get<1>(start);
+  const SharpSolution& before = std::get<2>(start);
   // u at the surface's vertices (the volume mesh keeps them first) and p = −u/|Ω| (mean temperature).
   std::vector<double> u(s.n_vertices()), p(s.n_vertices());
   for (std::size_t i = 0; i < u.size(); ++i) u[i] = before.u[Eigen::Index(i)], p[i] = -u[i] / before.volume;

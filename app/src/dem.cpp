@@ -145,6 +145,11 @@ std::optional<double> parse_number(const std::string& token) {
 
 }  // namespace
 
+bool same_frame(const HeightGrid& a, const HeightGrid& b) {
+  return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
+         a.cell_size == b.cell_size;
+}
+
 bool HeightGrid::valid(std::size_t row, std::size_t col) const { return !is_nodata(at(row, col), nodata); }
 
 std::size_t count_nodata(const HeightGrid& grid) {

@@ -23,6 +23,29 @@
 namespace bodyfit {
 namespace {
 
+/// Members whose grids cannot be combined: the case's error, which ends the ensemble (not a member
+/// that failed on its own).
+struct GridsDiffer : InputError {
+  using InputError::InputError;
+};
+
+void check_same_frame(const EnsembleRun& run, const std::string& name, const HeightGrid& grid, std::size_t index) {
+  std::lock_guard lock(run.frames->mutex);
+  auto [it, first] = run.frames->first.try_emplace(name, grid, index);
+  if (first) {
+    it->second.first.heights.clear();  // the frame only
+    return;
+  }
+  const HeightGrid& frame = it->second.first;
+  if (same_frame(frame, grid)) return;
+  throw GridsDiffer(fmt::format("members {} and {}: their '{}' grids differ ({} × {} cells of {} at ({}, {}) against {} "
+                                "× {} of {} at ({}, {})): the grid depends on a sampled parameter; give the model a "
+                                "grid that does not (bodyfit plugins --describe {} names its parameters)",
+                                it->second.second, index, name, frame.cols, frame.rows, frame.cell_size,
+                                frame.x_origin, frame.y_origin, grid.cols, grid.rows, grid.cell_size, grid.x_origin,
+                                grid.y_origin, run.model));
+}
+
 namespace fs = std::filesystem;
 
 fs::path member_stem(const fs::path& outdir, std::size_t index) {
@@ -118,8 +141,9 @@ bool evolve_member(const EnsembleRun& run, const MemberScenario& s, const std::a
       throw PluginError(fmt::format("model '{}' gave no '{}' grid at the end of the run: an ensemble combines the "
                                     "grids a model declares, and this run gave none",
                                     run.model, d.name));
-    write_raster(member_grid_path(run.outdir, s.index, d.name), to_raster(it->second),
-                 raster_metadata(it->second, d.unit));
+    const HeightGrid raster = to_raster(it->second);
+    check_same_frame(run, d.name, raster, s.index);
+    write_raster(member_grid_path(run.outdir, s.index, d.name), raster, raster_metadata(it->second, d.unit));
   }
   record.ok = true;
   return true;
@@ -204,6 +228,8 @@ bool run_member(const EnsembleRun& run, std::size_t index, const std::atomic<boo
     if (!evolve_member(run, s, stop, record)) return false;
   } catch (const IoError&) {
     throw;  // the ensemble's directory, not the member
+  } catch (const GridsDiffer&) {
+    throw;  // the case, not the member
   } catch (const std::exception& e) {
     record.ok = false;
     record.error = fmt::format("{}: {}", error_kind(e), e.what());

@@ -69,11 +69,6 @@ std::string read_text(const fs::path& file) {
   return s;
 }
 
-bool same_frame(const HeightGrid& a, const HeightGrid& b) {
-  return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
-         a.cell_size == b.cell_size;
-}
-
 /// Linear interpolation between closest ranks (the "type 7" percentile of sorted values).
 double percentile(const std::vector<double>& sorted, double p) {
   const double position = p / 100 * double(sorted.size() - 1);

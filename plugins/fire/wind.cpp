@@ -30,11 +30,6 @@ Vec3 wind_from_direction(double speed, double direction_deg) {
   return Vec3(-speed * std::sin(from), -speed * std::cos(from), 0);
 }
 
-bool same_frame(const HeightGrid& a, const HeightGrid& b) {
-  return a.cols == b.cols && a.rows == b.rows && a.x_origin == b.x_origin && a.y_origin == b.y_origin &&
-         a.cell_size == b.cell_size;
-}
-
 // Winds beyond this are not winds near the ground (the strongest measured, 113 m/s, in a cyclone):
 // a unit mistake (km/h, knots, cm/s) or a damaged value, refused where it is read.
 constexpr double kMaxWind = 150;

@@ -29,6 +29,9 @@ struct HeightGrid {
   double sample(double x, double y) const;
 };
 
+/// Whether two rasters have the same cells: size, origin and cell size.
+bool same_frame(const HeightGrid& a, const HeightGrid& b);
+
 /// The NODATA cells of a raster (NaN or the NODATA value).
 std::size_t count_nodata(const HeightGrid& grid);
 /// Gives every NODATA cell the value of its nearest valid cell (breadth-first over the

@@ -34,6 +34,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -122,6 +125,12 @@ std::filesystem::path member_record_path(const std::filesystem::path& outdir, st
 std::filesystem::path member_grid_path(const std::filesystem::path& outdir, std::size_t index, std::string_view name);
 
 /// Everything members need, shared by the ranks and threads of one ensemble.
+/// The frames of the members' grids seen so far (EnsembleRun::frames); shared by the threads.
+struct MemberFrames {
+  std::mutex mutex;
+  std::map<std::string, std::pair<HeightGrid, std::size_t>, std::less<>> first;  ///< by output: frame, member
+};
+
 struct EnsembleRun {
   std::filesystem::path case_file;
   std::vector<std::string> overrides;  ///< the user's --set
@@ -133,6 +142,10 @@ struct EnsembleRun {
   std::vector<OutputDecl> values;   ///< its values (a column each in members.csv)
   /// Test hook: these members throw a NumericalError instead of running.
   std::vector<std::size_t> inject_failures;
+  /// The frame of each combined grid, as the first member of this process to finish gave it: a
+  /// member whose grid differs stops the ensemble at once (a grid that depends on a sampled
+  /// parameter), instead of at the reduction after every member ran.
+  std::shared_ptr<MemberFrames> frames = std::make_shared<MemberFrames>();
 };
 
 /// The member's record when it is complete (record readable, its grids present when ok), else none.
