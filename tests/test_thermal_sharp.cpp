@@ -112,15 +112,19 @@ TEST_CASE("topological sensitivity: a small disk of G inserted where 4 gamma u p
   const int n = 48;
   auto solve = [&](double rho) {
     SurfaceMesh s = test::make_box(n, {-1, -1, -1}, {1, 1, 1});
-    std::vector<double> phi(s.n_vertices());
-    for (auto v : s.vertices()) {
-      const Vec3& p = s.point(v);
-      double d = 10;
-      if (p[2] == 1) d = std::hypot(p[0], p[1]) - 0.5;
-      if (p[2] == -1 && rho > 0) d = std::hypot(p[0], p[1]) - rho;
-      phi[std::size_t(v.idx())] = d;
-    }
-    discretize(s, phi);
+    auto level_set = [&] {  // the distance to the disks on the top and bottom faces
+      std::vector<double> phi(s.n_vertices());
+      for (auto v : s.vertices()) {
+        const Vec3& p = s.point(v);
+        double d = 10;
+        if (p[2] == 1) d = std::hypot(p[0], p[1]) - 0.5;
+        if (p[2] == -1 && rho > 0) d = std::hypot(p[0], p[1]) - rho;
+        phi[std::size_t(v.idx())] = d;
+      }
+      return phi;
+    };
+    discretize(s, level_set());
+    std::vector<double> phi = level_set();  // at the cut mesh's vertices too
     FaceMask g(s.n_faces(), 0);
     for (auto f : s.faces()) g[std::size_t(f.idx())] = s.inside(f);
     const VolumeMesh v = tetrahedralize(s, {.max_volume = regular_tet_volume(4.0 / n)});

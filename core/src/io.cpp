@@ -89,13 +89,13 @@ FileBytes::FileBytes(const std::filesystem::path& file) {
       if (errno == EINTR) continue;
       throw fail(errno);
     }
-    copy_.append(chunk, std::size_t(got));
-    if (!regular && copy_.size() > kStreamLimit) {
+    if (!regular && copy_.size() + std::size_t(got) > kStreamLimit) {  // checked first: no 2 GiB growth
       ::close(fd);
       throw file_error(file, fmt::format("not a regular file, and still going after {} GiB (a device such as "
                                          "/dev/zero?): save it to a file first",
                                          kStreamLimit >> 30));
     }
+    copy_.append(chunk, std::size_t(got));
   }
   ::close(fd);
 }

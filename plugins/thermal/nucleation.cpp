@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <stdexcept>
 
 namespace bodyfit::thermal {
 
@@ -19,6 +20,9 @@ std::vector<double> topological_sensitivity(const SurfaceMesh& mesh, const std::
 std::vector<int> nucleation_sites(const SurfaceMesh& mesh, const std::vector<double>& distance,
                                   const std::vector<double>& sensitivity, const std::vector<char>& excluded,
                                   const NucleationOptions& options) {
+  if (distance.size() != mesh.n_vertices() || sensitivity.size() != mesh.n_vertices() ||
+      (!excluded.empty() && excluded.size() != mesh.n_vertices()))
+    throw std::invalid_argument("nucleation_sites: the fields are not the mesh's (one value per vertex)");
   const double keep = options.radius + options.clearance;
   std::vector<Vec3> forbidden;  // Γ_N's vertices: a disk's centre stays `keep` away from them
   for (auto v : mesh.vertices())
