@@ -14,6 +14,8 @@ PACKAGES=(
   gdal-bin  # gdal_translate: the GeoTIFF test converts an .asc to .tif with it
   python3  # scripts/docs.py: the manual's generated pages and figures (CTest docs_up_to_date)
   python3-vtk9 python3-meshio  # tests/test_io.cpp cross-checks VTU and Medit files (skipped when absent)
+  python3-dev pybind11-dev python3-numpy  # the Python module (python/)
+  python3-pytest python3-scipy python3-pandas python3-matplotlib  # its tests; sparse matrices, histories, plots
   clang libclang-rt-14-dev llvm  # the sanitize and fuzz stages of run_tests.sh: ASan/UBSan, libFuzzer, llvm-symbolizer
 )
 

@@ -13,8 +13,10 @@ LoadedModel load_case_model(const CaseConfig& config) {
   return model;
 }
 
-Run::Run(CaseConfig config, const std::filesystem::path& output_dir)
-    : config_(std::move(config)), model_(load_case_model(config_)), setup_(setup_case(config_)) {
+Run::Run(CaseConfig config, const std::filesystem::path& output_dir, const ModelLoader& load_model)
+    : config_(std::move(config)),
+      model_(load_model ? load_model(config_) : load_case_model(config_)),
+      setup_(setup_case(config_)) {
   setup_.options.output_dir = output_dir;
   setup_.options.height_field = config_.surface.height_field();
 }

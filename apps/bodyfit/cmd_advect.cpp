@@ -3,12 +3,9 @@
 #include "commands.hpp"
 #include "validators.hpp"
 
-#include <bodyfit/advection.hpp>
-#include <bodyfit/error.hpp>
-#include <bodyfit/guards.hpp>
+#include <bodyfit/app/stages.hpp>
 #include <bodyfit/io.hpp>
 
-#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -60,15 +57,9 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
             const auto advect_start = std::chrono::steady_clock::now();
             bodyfit::AdvectionReport report;
             args->options.gradient_correction = !args->plain_p1;
-            const auto result = bodyfit::advect(mesh, phi, velocity, args->time, args->options, &report);
+            const auto result =
+                bodyfit::advect_stage(mesh, phi, velocity, args->time, args->options, &report);
             const double advect_ms = ms_since(advect_start);
-            // A lost characteristic leaves a value from the middle of its path: a wrong answer.
-            if (report.lost > 0)
-              throw bodyfit::NumericalError(fmt::format(
-                  "advect: {} of {} characteristics were lost (a walk stalled or overflowed, or a trace reached its "
-                  "bound of sub-steps); {} not written: shorten --time or check the velocity",
-                  report.lost, report.traced, args->output));
-            bodyfit::require_finite(result, "advect: the advected level set");
             bodyfit::write_scalar_sol(args->output, result);
             spdlog::info(
                 "advect: {} vertices, {} faces, T = {}, RK{}; {} characteristics, {} sub-steps, {} stopped on the "

@@ -4,11 +4,8 @@
 #include "remesh_options.hpp"
 #include "validators.hpp"
 
-#include <bodyfit/geometry.hpp>
-#include <bodyfit/guards.hpp>
+#include <bodyfit/app/stages.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/levelset_mesher.hpp>
-#include <bodyfit/remesh.hpp>
 
 #include <spdlog/spdlog.h>
 
@@ -62,30 +59,23 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
             Stopwatch clock;
             auto mesh = bodyfit::read_mesh(*input);
             auto phi = bodyfit::read_scalar_sol(*phi_file, mesh.n_vertices());
-            if (!*no_remesh)
-              bodyfit::check_face_budget(bodyfit::estimate_remesh_faces(mesh, *options),
-                                         "discretize: edges of at most hmax");
             double read_ms = clock.lap();
             std::size_t faces_before = mesh.n_faces();
-            // The default size is the input's resolution, measured before the cut adds its small edges.
-            if (options->hmax <= 0) options->hmax = bodyfit::resolution_length(mesh);
-            auto report = bodyfit::discretize(mesh, phi, *cut);
-            double cut_ms = clock.lap();
+            const auto stage = bodyfit::discretize_stage(mesh, phi, *cut, *options, !*no_remesh);
+            clock.lap();
+            const auto& report = stage.cut;
             auto quality = bodyfit::quality_stats(mesh);
             spdlog::info("discretize: {} -> {} faces, {} crossed edges, {} snapped and {} separated vertices, "
                          "{} flipped diagonals, {} specks removed; {} interface edges, {} inside faces; quality min {:.3g} mean {:.3f}; "
                          "{:.1f} ms (read {:.1f} ms)",
                          faces_before, mesh.n_faces(), report.crossed_edges, report.snapped_vertices,
                          report.separated_vertices, report.flipped_diagonals, report.removed_specks, report.interface_edges,
-                         report.inside_faces, quality.min, quality.mean, cut_ms, read_ms);
-            if (!*no_remesh) {
-              auto remeshed = bodyfit::remesh(mesh, *options);
-              double remesh_ms = clock.lap();
+                         report.inside_faces, quality.min, quality.mean, stage.cut_ms, read_ms);
+            if (const auto& remeshed = stage.remesh)
               spdlog::info("remesh: {} faces, quality min {:.3f} mean {:.3f}; {} splits, {} collapses, {} flips, "
                            "{} relocations in {} passes; {:.1f} ms",
-                           mesh.n_faces(), remeshed.min_quality, remeshed.mean_quality, remeshed.splits,
-                           remeshed.collapses, remeshed.flips, remeshed.relocations, remeshed.passes, remesh_ms);
-            }
+                           mesh.n_faces(), remeshed->min_quality, remeshed->mean_quality, remeshed->splits,
+                           remeshed->collapses, remeshed->flips, remeshed->relocations, remeshed->passes, stage.remesh_ms);
             bodyfit::write_mesh(mesh, *output);
             spdlog::info("wrote {} ({:.1f} ms)", *output, clock.lap());
             return 0;

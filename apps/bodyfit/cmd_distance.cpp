@@ -3,9 +3,8 @@
 #include "commands.hpp"
 #include "validators.hpp"
 
-#include <bodyfit/distance.hpp>
+#include <bodyfit/app/stages.hpp>
 #include <bodyfit/error.hpp>
-#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 
 #include <spdlog/spdlog.h>
@@ -41,24 +40,12 @@ bodyfit::cli::Command setup_distance(CLI::App& app) {
             bodyfit::DistanceOptions options;
             if (args->narrow_band > 0) options.narrow_band = args->narrow_band;
             bodyfit::DistanceReport report;
-            bodyfit::ScalarField d;
-            if (phi->count() > 0) {
-              const auto values = bodyfit::read_scalar_sol(args->phi, mesh.n_vertices());
-              d = bodyfit::signed_distance(mesh, values, options, &report);
-            } else {
-              // The region is the faces whose ref is the given one; its interface, the edges between it
-              // and the other faces (whatever the file marked as interface).
-              for (auto f : mesh.faces())
-                mesh.region(f) = mesh.region(f) == args->region ? bodyfit::kInside : bodyfit::kOutside;
-              bodyfit::update_interface_from_regions(mesh);
-              d = bodyfit::signed_distance_to_region(mesh, options, &report);
-            }
+            const bodyfit::ScalarField phi_values =
+                phi->count() > 0 ? bodyfit::read_scalar_sol(args->phi, mesh.n_vertices()) : bodyfit::ScalarField();
+            const bodyfit::ScalarField d = bodyfit::distance_stage(mesh, phi->count() > 0 ? &phi_values : nullptr,
+                                                                   args->region, options, &report);
             if (!report.has_interface)
               spdlog::warn("distance: no interface (the level set does not change sign): all values are ±infinity");
-            // Medit files cannot hold infinities portably: write ±1e300 instead.
-            for (double& value : d)
-              if (std::isinf(value)) value = value > 0 ? 1e300 : -1e300;
-            bodyfit::require_finite(d, "distance: the signed distance");
             bodyfit::write_scalar_sol(args->output, d);
             const double total =
                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -3,10 +3,8 @@
 #include "commands.hpp"
 #include "remesh_options.hpp"
 
-#include <bodyfit/geometry.hpp>
-#include <bodyfit/guards.hpp>
+#include <bodyfit/app/stages.hpp>
 #include <bodyfit/io.hpp>
-#include <bodyfit/remesh.hpp>
 
 #include <spdlog/spdlog.h>
 
@@ -33,10 +31,9 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
   return {cmd, [=]() {
             auto start = std::chrono::steady_clock::now();
             auto mesh = bodyfit::read_mesh(*input);
-            bodyfit::check_face_budget(bodyfit::estimate_remesh_faces(mesh, *options), "remesh: edges of at most hmax");
             auto before = bodyfit::quality_stats(mesh);
             std::size_t faces_before = mesh.n_faces();
-            auto report = bodyfit::remesh(mesh, *options);
+            auto report = bodyfit::remesh_stage(mesh, *options);
             bodyfit::write_mesh(mesh, *output);
             double total = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
             spdlog::info("remesh: {} -> {} faces, quality min {:.3f} mean {:.3f} (before {:.3f} / {:.3f})", faces_before,

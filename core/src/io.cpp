@@ -408,6 +408,40 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
 
 }  // namespace io_detail
 
+SurfaceMesh mesh_from_arrays(std::span<const double> xyz, std::span<const std::int64_t> triangles,
+                             std::span<const int> regions, const std::string& origin, const ReadOptions& options) {
+  using namespace io_detail;
+  if (xyz.size() % 3 || triangles.size() % 3)
+    throw InputError(fmt::format("{}: {} coordinates and {} indices: 3 per vertex and per triangle expected", origin,
+                                 xyz.size(), triangles.size()));
+  if (!regions.empty() && regions.size() != triangles.size() / 3)
+    throw InputError(fmt::format("{}: {} regions for {} triangles: one per triangle expected", origin, regions.size(),
+                                 triangles.size() / 3));
+  MeshRecords r;
+  r.vertex_at = r.triangle_at = r.edge_at = Locator::none();
+  r.corner_at = r.required_vertex_at = r.ridge_at = r.required_edge_at = Locator::none();
+  r.points.resize(xyz.size() / 3);
+  for (std::size_t i = 0; i < r.points.size(); ++i) r.points[i] = Vec3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+  r.vertex_refs.assign(r.points.size(), 0);
+  // Arrays count from 0 (the builder's messages count from 1, as files do): what an array user
+  // reads first is checked here, in the arrays' terms.
+  for (std::size_t i = 0; i < r.points.size(); ++i)
+    if (!std::isfinite(xyz[3 * i]) || !std::isfinite(xyz[3 * i + 1]) || !std::isfinite(xyz[3 * i + 2]))
+      throw InputError(fmt::format("{}: vertices[{}] has a NaN or infinite coordinate", origin, i));
+  const auto nv = static_cast<std::int64_t>(r.points.size());
+  r.triangles.resize(triangles.size() / 3);
+  for (std::size_t i = 0; i < r.triangles.size(); ++i) {
+    for (int k = 0; k < 3; ++k)
+      if (triangles[3 * i + k] < 0 || triangles[3 * i + k] >= nv)
+        throw InputError(fmt::format("{}: triangles[{}] refers to vertex {}, expected an index in 0..{}", origin, i,
+                                     triangles[3 * i + k], nv - 1));
+    r.triangles[i] = {triangles[3 * i], triangles[3 * i + 1], triangles[3 * i + 2]};
+  }
+  r.triangle_refs.assign(regions.begin(), regions.end());
+  if (r.triangle_refs.empty()) r.triangle_refs.assign(r.triangles.size(), 0);
+  return build_mesh(std::move(r), origin, options);
+}
+
 SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options) {
   using namespace io_detail;
   const std::string ext = extension_of(file);

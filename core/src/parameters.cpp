@@ -231,6 +231,17 @@ const std::vector<ParameterDecl>& Parameters::declarations() const {
   return declarations_ ? *declarations_ : none;
 }
 
+void Parameters::declare(std::vector<ParameterDecl> more) {
+  auto all = std::make_shared<std::vector<ParameterDecl>>(declarations());
+  for (ParameterDecl& d : more) {
+    d.key = prefix_ + d.key;
+    if (std::any_of(all->begin(), all->end(), [&](const ParameterDecl& x) { return x.key == d.key; }))
+      throw std::logic_error(fmt::format("[{}] {}: declared twice", section_, d.key));
+    all->push_back(std::move(d));
+  }
+  declarations_ = std::move(all);
+}
+
 bool Parameters::has(std::string_view key) const { return table_.contains(key); }
 
 bool Parameters::is_table(std::string_view key) const {

@@ -111,6 +111,15 @@ LoadedModel& LoadedModel::operator=(LoadedModel&& other) noexcept {
 
 LoadedModel::~LoadedModel() { reset(); }
 
+LoadedModel LoadedModel::hosted(std::unique_ptr<VelocityModel> model, std::filesystem::path origin) {
+  LoadedModel loaded;
+  loaded.model_ = model.release();
+  loaded.destroy_ = [](VelocityModel* m) { delete m; };
+  loaded.file_ = std::move(origin);
+  loaded.abi_ = kPluginAbi;
+  return loaded;
+}
+
 PluginInfo LoadedModel::info() const {
   return {.file = file_,
           .abi = abi_,

@@ -14,7 +14,9 @@
 // failed or interrupted write never leaves a half-written file behind.
 #include <bodyfit/mesh.hpp>
 
+#include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -29,6 +31,12 @@ struct ReadOptions {
 /// Medit refs and tags map onto the mesh properties (see docs/reference/formats.md); e:interface is set on
 /// edges listed with ref 10 and on edges between a face of region 3 and a face of another region.
 SurfaceMesh read_mesh(const std::filesystem::path& file, const ReadOptions& options = {});
+/// A mesh from arrays (the Python module's bodyfit.Mesh): `xyz` holds 3 coordinates per vertex,
+/// `triangles` 3 vertex indices (0-based) per face, `regions` one ref per face (empty: all 0).
+/// Checked as every reader checks a file; errors name `origin` and the vertex or triangle (1-based).
+SurfaceMesh mesh_from_arrays(std::span<const double> xyz, std::span<const std::int64_t> triangles,
+                             std::span<const int> regions, const std::string& origin,
+                             const ReadOptions& options = {});
 /// Write any supported mesh format (.mesh .meshb .obj .off .ply .stl .vtu), chosen by extension.
 /// .mesh/.meshb keep refs and tags: Edges lists interface (ref 10), ridge, required, non-zero-ref
 /// and boundary edges. Deleted elements are skipped and the vertices renumbered in order.

@@ -138,6 +138,10 @@ class Parameters {
   bool is_table(std::string_view key) const;
   /// The declaration of `key` of this table (nullptr without declarations, or when undeclared).
   const ParameterDecl* declaration(std::string_view key) const;
+  /// Declare more keys while configuring: a model whose parameters depend on one of its keys (the
+  /// python model learns its class's parameters from `module` and `class`). Call it before
+  /// section(); the keys are then read and checked as the others.
+  void declare(std::vector<ParameterDecl> more);
 
   // With declarations: the declared default (required when there is none) and range. Without,
   // string() and path() give "" when the key is absent; the others need a fallback.

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,9 @@ class LoadedModel {
   LoadedModel(LoadedModel&&) noexcept;
   LoadedModel& operator=(LoadedModel&&) noexcept;
   ~LoadedModel();
+  /// A model made by the program itself, not loaded from a plugin (a Python object given to
+  /// bodyfit.run): `origin` names it in messages as a plugin's file does; its ABI is ours.
+  static LoadedModel hosted(std::unique_ptr<VelocityModel> model, std::filesystem::path origin);
   VelocityModel& model() const { return *model_; }
   VelocityModel* operator->() const { return model_; }
   const std::filesystem::path& file() const { return file_; }

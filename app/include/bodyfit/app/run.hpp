@@ -8,6 +8,7 @@
 #include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
+#include <functional>
 #include <optional>
 
 namespace bodyfit {
@@ -17,13 +18,16 @@ namespace bodyfit {
 /// naming the key, and why when the model says).
 LoadedModel load_case_model(const CaseConfig& config);
 
+/// Where a run's model comes from: load_case_model, or a model the caller makes (a Python object).
+using ModelLoader = std::function<LoadedModel(const CaseConfig& config)>;
+
 class Run {
  public:
   /// Load and configure the case's model, then build S, its reference and T^0. `output_dir`
   /// ("" for none) is where the model may write its own files (StepContext::output_dir). Give the
   /// case moved, not copied: a copy of a TOML table forgets the files its values came from, which
   /// the model's file names are resolved against.
-  Run(CaseConfig config, const std::filesystem::path& output_dir);
+  Run(CaseConfig config, const std::filesystem::path& output_dir, const ModelLoader& load_model = {});
 
   const CaseConfig& config() const { return config_; }
   LoadedModel& model() { return model_; }
