@@ -381,7 +381,16 @@ PYBIND11_MODULE(_bodyfit, m) {
         }
         return copy_of(d);
       },
-      py::arg("mesh"), py::arg("phi") = py::none(), py::arg("region") = py::none(), py::arg("narrow_band") = 0.0);
+      py::arg("mesh"), py::arg("phi") = py::none(), py::arg("region") = py::none(), py::arg("narrow_band") = 0.0,
+      R"(The signed geodesic distance at the vertices (negative inside), as `bodyfit distance`.
+
+mesh         the surface
+phi          (n,) level set: the distance to its zero set; or
+region       a face ref: the distance to the faces with this ref (its interface: the edges
+             between them and the rest)
+narrow_band  stop beyond this |d| (those vertices get ±1e300); 0: everywhere
+
+Without an interface (phi of one sign) every value is ±1e300. Returns an (n,) array.)");
   m.def(
       "advect",
       [](const Mesh& m, py::handle phi, py::handle velocity, double time, int steps, int rk, bool p1, double cells,
@@ -409,7 +418,22 @@ PYBIND11_MODULE(_bodyfit, m) {
       },
       py::arg("mesh"), py::arg("phi"), py::arg("velocity"), py::arg("time"), py::arg("steps") = AdvectionOptions{}.steps,
       py::arg("rk") = AdvectionOptions{}.rk_order, py::arg("p1") = false,
-      py::arg("cells") = AdvectionOptions{}.max_cells_per_substep, py::arg("max_substeps") = AdvectionOptions{}.max_substeps);
+      py::arg("cells") = AdvectionOptions{}.max_cells_per_substep, py::arg("max_substeps") = AdvectionOptions{}.max_substeps,
+      R"(Solve dφ/dt + V·∇φ = 0 on the surface over (0, time) by characteristics, as `bodyfit advect`.
+
+mesh          the surface
+phi           (n,) level set at the vertices
+velocity      (n, 3) tangential velocity at the vertices (frozen over the interval)
+time          final time T ≥ 0
+steps         outer steps over (0, T)
+rk            Runge-Kutta order of the tracing: 2 or 4
+p1            plain P1 interpolation at the feet (default: P1 averaged with the vertex-gradient
+              Taylor expansions, which removes the O(h²) interpolation bias)
+cells         edge lengths crossed per sub-step, at most about
+max_substeps  refuse to start when the sub-steps of all characteristics are estimated above
+              this (0: no limit)
+
+Returns the (n,) advected level set; NumericalError when a characteristic is lost.)");
   m.def(
       "discretize",
       [](const Mesh& m, py::handle phi, double snap, double snap_fixed, double speck, std::optional<double> hmin,
@@ -436,7 +460,27 @@ PYBIND11_MODULE(_bodyfit, m) {
       py::arg("snap_fixed") = DiscretizeOptions{}.fixed_snap_ratio, py::arg("speck") = DiscretizeOptions{}.speck_area,
       py::arg("hmin") = py::none(), py::arg("hmax") = py::none(), py::arg("hausd") = py::none(),
       py::arg("hausd_interface") = py::none(), py::arg("hgrad") = RemeshOptions{}.hgrad,
-      py::arg("angle") = RemeshOptions{}.feature_angle, py::arg("remesh") = true);
+      py::arg("angle") = RemeshOptions{}.feature_angle, py::arg("remesh") = true,
+      R"(Cut the zero level set of phi into the mesh, then remesh, as `bodyfit discretize` (mmgs -ls 0).
+
+mesh             the surface
+phi              (n,) level set at the vertices, negative inside
+snap             put a vertex on the level set when the crossing is closer than this fraction of
+                 the edge, in [0, 0.5]
+snap_fixed       the same for vertices the remesher cannot move (boundary, ridges, corners,
+                 required); the larger of the two applies
+speck            give parts of a region smaller than this many h² (h: mean edge length) to the
+                 region around them
+hmin             smallest edge length (default hmax/20)
+hmax             largest edge length (default: the input's resolution, the side of an
+                 equilateral triangle of its mean area, measured before the cut)
+hausd            allowed distance to the surface and interface (default diagonal/1000)
+hausd_interface  allowed distance to the interface curve alone (default hausd)
+hgrad            gradation between neighbouring sizes, ≥ 1
+angle            ridge detection angle in degrees, ≤ 0 disables
+remesh           False: only cut the level set in (thin triangles remain)
+
+Returns a new Mesh: regions 3 (inside) and 2 (outside), the interface as edges.)");
   m.def(
       "remesh",
       [](const Mesh& m, std::optional<double> hmin, std::optional<double> hmax, std::optional<double> hausd,
@@ -455,7 +499,21 @@ PYBIND11_MODULE(_bodyfit, m) {
       py::arg("mesh"), py::arg("hmin") = py::none(), py::arg("hmax") = py::none(), py::arg("hausd") = py::none(),
       py::arg("hausd_interface") = py::none(), py::arg("hgrad") = RemeshOptions{}.hgrad,
       py::arg("angle") = RemeshOptions{}.feature_angle, py::arg("passes") = RemeshOptions{}.max_passes,
-      py::arg("full") = false);
+      py::arg("full") = false,
+      R"(Remesh to high quality, keeping S, the interface and the features, as `bodyfit remesh` (mmgs).
+
+mesh             the surface
+hmin             smallest edge length (default hmax/20)
+hmax             largest edge length (default: the input's resolution)
+hausd            allowed distance to the surface and interface (default diagonal/1000)
+hausd_interface  allowed distance to the interface curve alone (default hausd)
+hgrad            gradation between neighbouring sizes, ≥ 1
+angle            ridge detection angle in degrees, ≤ 0 disables
+passes           cap on the collapse/flip/relocate passes (0: none; they stop when done or when
+                 they stop making progress)
+full             work on every vertex, not only where the mesh needs change
+
+Returns a new Mesh; InputError when the sizes would make more faces than the budget.)");
   m.def(
       "info_json",
       [](const Mesh& m) {

@@ -139,3 +139,24 @@ def test_version_and_build_info():
     bodyfit.set_threads(0)
     with pytest.raises(bodyfit.InputError):
         bodyfit.set_threads(-1)
+
+
+def test_every_option_is_documented_and_stubbed():
+    """help(bodyfit.<stage>) explains each keyword, and the stubs declare the same defaults."""
+    import ast
+    import pathlib
+    import re
+    stubs = (pathlib.Path(bodyfit.__file__).parent / "_bodyfit.pyi").read_text()
+    for stage in (bodyfit.signed_distance, bodyfit.advect, bodyfit.discretize, bodyfit.remesh):
+        doc = stage.__doc__
+        signature = doc.splitlines()[0]
+        names = re.findall(r"(\w+): [^,)]+", signature[signature.index("(") + 1:])
+        for name in names:
+            assert re.search(rf"^{name}\s+\S", doc, re.M), f"{stage.__name__}: option {name} is not explained"
+        defaults = dict(re.findall(r"(\w+): [\w\[\]\.]+ = ([^,)]+)", signature))
+        stub = stubs[stubs.index(f"def {stage.__name__}("):]
+        stub = stub[:stub.index("...")]
+        stub_defaults = dict(re.findall(r"(\w+): [\w\[\]\.]+ = ([^,)]+)", stub))
+        assert stub_defaults.keys() == defaults.keys(), stage.__name__
+        for name, value in defaults.items():
+            assert ast.literal_eval(stub_defaults[name]) == ast.literal_eval(value), f"{stage.__name__}: {name}"
