@@ -33,13 +33,17 @@ void start_interpreter() {
   // No signal handlers of Python's: Ctrl-C is the driver's (the run stops after the iteration).
   py::initialize_interpreter(false);
   py::module_::import("_bodyfit_host");
-  // A model's `import bodyfit` finds the package of this build (<build>/python, beside lib/),
-  // wherever the Python path points.
+  // A model's `import bodyfit` finds the package of this build or install, wherever the Python
+  // path points: <build>/python beside lib/, or <prefix>/lib/python3.X/dist-packages.
   Dl_info self{};
   if (dladdr(reinterpret_cast<const void*>(&start_interpreter), &self) && self.dli_fname) {
-    const auto package = std::filesystem::path(self.dli_fname).parent_path() / "../../../python";
-    if (std::filesystem::exists(package / "bodyfit" / "__init__.py"))
-      py::module_::import("sys").attr("path").attr("append")(std::filesystem::weakly_canonical(package).string());
+    const auto plugins = std::filesystem::path(self.dli_fname).parent_path();
+    const std::string version = "python" + std::to_string(PY_MAJOR_VERSION) + "." + std::to_string(PY_MINOR_VERSION);
+    for (const auto& package : {plugins / "../../../python", plugins / "../.." / version / "dist-packages"})
+      if (std::filesystem::exists(package / "bodyfit" / "__init__.py")) {
+        py::module_::import("sys").attr("path").attr("append")(std::filesystem::weakly_canonical(package).string());
+        break;
+      }
   }
   PyEval_SaveThread();
 }

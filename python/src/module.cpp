@@ -1,5 +1,5 @@
 // The bodyfit Python module's native part (_bodyfit): meshes and fields as numpy arrays, the
-// stages with the command line's options and checks (app/stages.hpp), runs (app/run_case.hpp)
+// stages with the command line's options and checks (<bodyfit/app/stages.hpp>), runs (<bodyfit/app/run_case.hpp>)
 // with models written in Python (python_model.hpp). The GIL is released in every stage and run.
 #include "arrays.hpp"
 #include "python_model.hpp"
