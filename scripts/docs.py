@@ -239,6 +239,7 @@ class Measurer:
         self.env = dict(os.environ, BODYFIT=str(build / "bin" / "bodyfit"), BUILD=str(build), ROOT=str(ROOT))
         self.work = tempfile.TemporaryDirectory(prefix="bodyfit_figures_")
         self.runs = {}
+        self.failures = {}
 
     def shell(self, command, cwd):
         return subprocess.run(["bash", "-c", PRELUDE + command], cwd=cwd, env=self.env, capture_output=True, text=True)
@@ -248,10 +249,13 @@ class Measurer:
         if row["run"] not in self.runs:
             directory = pathlib.Path(self.work.name) / str(len(self.runs))
             directory.mkdir()
+            self.runs[row["run"]] = directory
             result = self.shell(row["run"], directory)
             if result.returncode != 0:
-                raise RuntimeError(f"{row['id']}: the command failed (exit {result.returncode}):\n{result.stderr[-2000:]}")
-            self.runs[row["run"]] = directory
+                # Every figure of this command fails with this message, not only the first.
+                self.failures[row["run"]] = f"the command failed (exit {result.returncode}):\n{result.stderr[-2000:]}"
+        if row["run"] in self.failures:
+            raise RuntimeError(f"{row['id']}: {self.failures[row['run']]}")
         result = self.shell(row["read"], self.runs[row["run"]])
         lines = [line for line in result.stdout.splitlines() if line.strip()]
         if result.returncode != 0 or not lines:

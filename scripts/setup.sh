@@ -34,19 +34,26 @@ else
   echo "setup: all build dependencies present"
 fi
 
-# Public parts the tests run the models on (meshes/public/README.md): extracted from Debian's own
-# packages, not installed (libcgal-demo would pull in CGAL).
+# Public meshes (meshes/public/README.md): CGAL's example meshes, extracted from Debian's own
+# libcgal-demo package, not installed (it would pull in CGAL). fandisk.off is a thermal case's part;
+# the others are bench_real_meshes's set (docs/validation/real_meshes.md).
 PUBLIC="$(cd "$(dirname "$0")/.." && pwd)/meshes/public"
-if [[ ! -s "$PUBLIC/fandisk.off" ]]; then
+PUBLIC_MESHES=(fandisk anchor blade bull ChineseDragon-10kv cheese couplingdown elephant elephant-with-holes femur
+               joint knot1 mushroom)
+absent=()
+for m in "${PUBLIC_MESHES[@]}"; do [[ -s "$PUBLIC/$m.off" ]] || absent+=("$m"); done
+if ((${#absent[@]})); then
   work=$(mktemp -d)
   trap 'rm -rf "$work"' EXIT
   download() { (cd "$work" && apt-get download -qq libcgal-demo 2> /dev/null); }
   SUDO=""
   [[ $(id -u) -ne 0 ]] && SUDO="sudo"
   download || { $SUDO apt-get update -qq && download; } || { echo "setup: cannot download libcgal-demo" >&2; exit 1; }
-  dpkg-deb --fsys-tarfile "$work"/libcgal-demo_*.deb | tar -xO ./usr/share/doc/libcgal-dev/data.tar.gz |
-    tar -xzO data/meshes/fandisk.off > "$work/fandisk.off"
-  [[ -s "$work/fandisk.off" ]] || { echo "setup: fandisk.off not found in libcgal-demo" >&2; exit 1; }
-  mv "$work/fandisk.off" "$PUBLIC/fandisk.off"
-  echo "setup: meshes/public/fandisk.off extracted from libcgal-demo"
+  dpkg-deb --fsys-tarfile "$work"/libcgal-demo_*.deb | tar -xO ./usr/share/doc/libcgal-dev/data.tar.gz > "$work/data.tar.gz"
+  for m in "${absent[@]}"; do
+    tar -xzOf "$work/data.tar.gz" "data/meshes/$m.off" > "$work/$m.off"
+    [[ -s "$work/$m.off" ]] || { echo "setup: $m.off not found in libcgal-demo" >&2; exit 1; }
+    mv "$work/$m.off" "$PUBLIC/$m.off"
+  done
+  echo "setup: meshes/public: ${absent[*]} extracted from libcgal-demo"
 fi

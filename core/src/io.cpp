@@ -370,8 +370,9 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   // open along the faces that use the copy (a boundary where there is none). Boundary vertices only:
   // they are few, and a duplicate that opens nothing cannot lie anywhere else. MMG and CGAL take such
   // files: every set of vertices at one point is merged and the surface built again, with a warning
-  // (the vertices are renumbered); when that does not give a valid surface either, the duplicate is
-  // the error.
+  // (the vertices are renumbered). When merging does not give a valid surface (two holes or two
+  // fans that touch at a point: merged, the point would join separate fans), the vertices are kept
+  // apart, as those tools do too: the surface touches itself there, which a warning says.
   {
     std::vector<int> boundary;
     for (auto v : mesh.vertices())
@@ -385,11 +386,6 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
       const int a = boundary[k - 1], b = boundary[k];
       if (mesh.point(VertexHandle(a)) != mesh.point(VertexHandle(b))) continue;
       const Vec3& p = mesh.point(VertexHandle(b));
-      const InputError duplicate = r.vertex_at.error(
-          file, std::size_t(b),
-          fmt::format("vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on a boundary: a "
-                      "duplicated vertex cuts the surface open there; merge them",
-                      a + 1, b + 1, p[0], p[1], p[2]));
       std::size_t merged = 0;
       MeshRecords joined = merge_coincident_vertices(r, merged);
       try {
@@ -398,8 +394,11 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
                      "and CGAL do: the surface is closed there, and its vertices are renumbered",
                      file.string(), merged, b + 1, a + 1);
         return whole;
-      } catch (const InputError&) {
-        throw duplicate;
+      } catch (const InputError& e) {
+        spdlog::warn("{}: vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on a boundary, and "
+                     "merging them would not give a surface ({}): kept apart, the surface touches itself there",
+                     file.string(), a + 1, b + 1, p[0], p[1], p[2], e.what());
+        return mesh;
       }
     }
   }
