@@ -6,6 +6,7 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
+#include <bodyfit/remesh.hpp>
 
 #include "test_support.hpp"
 
@@ -309,6 +310,27 @@ TEST_CASE("outputs that cannot be written are I/O errors (exit 6)") {
       {"mesh sphere --faces 100 -o {d}/dir.mesh", 6, "cannot rename", ""},
       {"run {d}/case.toml -o {d}/a_file/out", 6, "a_file", "a_file/out"},
   });
+}
+
+TEST_CASE("a remesh whose curvature sizes outgrow the face budget stops with an input error, not out of memory") {
+  // hmax allows the input's faces (the budget checked before), a tiny hausd asks for ~10⁵.
+  const SurfaceMesh sphere = make_sphere({.faces = 500});
+  const std::size_t saved = max_faces();
+  set_max_faces(3000);
+  RemeshOptions options;
+  options.hmax = 0.3;
+  options.hmin = 1e-4;
+  options.hausd = 1e-7;
+  SurfaceMesh mesh = sphere;
+  CHECK_NOTHROW(check_face_budget(estimate_remesh_faces(mesh, options), "remesh"));
+  try {
+    remesh(mesh, options);
+    FAIL("the remesh grew beyond the budget");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()).find("remesh: the sizes the curvature and hausd ask for") == 0);
+  }
+  CHECK(mesh.n_faces() <= 3000);
+  set_max_faces(saved);
 }
 
 TEST_CASE("the guards: face budget, finiteness, and the exit code of each class") {

@@ -4,6 +4,8 @@
 // class is in remesher.hpp, its operators, features and repair in remesh_*.cpp.
 #include "remesher.hpp"
 
+#include <bodyfit/guards.hpp>
+
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
@@ -107,6 +109,9 @@ void Remesher::split_long_edges() {
     // Room for the round's new elements at once (a split adds a vertex, three edges and two faces),
     // instead of the arrays doubling (and being copied) several times within it.
     const std::size_t k = ranked_.size();
+    // The budget checked before the remesh counts faces of hmax; curvature and hausd may ask for
+    // far smaller edges (a spike, a tiny hausd): the growth itself is bounded, round by round.
+    check_face_budget(double(m_.n_faces() + 2 * k), "remesh: the sizes the curvature and hausd ask for");
     m_.reserve(m_.n_vertices() + k, m_.n_edges() + 3 * k, m_.n_faces() + 2 * k);
     const std::size_t before = report_.splits;
     created.clear();
