@@ -762,6 +762,19 @@ TEST_CASE("specks: parts of a region below speck_area·h² go to the region arou
   }
 }
 
+TEST_CASE("specks: a speck area above the whole surface's gives G away once and stops") {
+  // Every part is then a speck: G goes to the region around it, and the surface, one region with
+  // nothing around it, is not given back (the two used to trade places without end).
+  const int n = 16;
+  SurfaceMesh mesh = make_square(n);
+  const auto phi = sample(mesh, [](const Vec3& p) { return (p - Vec3(0.5, 0.5, 0)).norm() - 0.2; });
+  const auto report = discretize(mesh, phi, {.speck_area = 1e300});
+  require_valid(mesh, strict(1, 1));
+  CHECK(report.removed_specks == 1);
+  CHECK(region_components(mesh, kInside) == 0);
+  CHECK(region_area(mesh, kOutside) == doctest::Approx(1.0));
+}
+
 TEST_CASE("specks: the threshold is the part's area, however far the search stops") {
   // Two single-vertex islands of φ < 0 with linear crossings: each encloses t² times the star of
   // its vertex, t = a / (a + b) the crossings' fraction. One is set just under speck_area·h², the

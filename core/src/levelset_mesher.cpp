@@ -281,7 +281,7 @@ std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area
       const int id = int(parts.size());
       const int region = mesh.region(seed);
       double area = 0;
-      bool large = false;
+      bool large = false, bordered = false;
       part_faces.clear();
       stack.assign(1, seed);
       mark[std::size_t(seed.idx())] = id;
@@ -292,7 +292,10 @@ std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area
         area += face_area(mesh, f);
         large = area >= min_area;
         for (auto g : mesh.ff_range(f)) {
-          if (mesh.region(g) != region) continue;
+          if (mesh.region(g) != region) {
+            bordered = true;
+            continue;
+          }
           int& m = mark[std::size_t(g.idx())];
           if (m == kLarge) large = true;  // joined to a part already known to be large
           if (m != kUnseen) continue;
@@ -302,6 +305,10 @@ std::size_t remove_specks(SurfaceMesh& mesh, ScalarField& value, double min_area
         }
       }
       touched.insert(touched.end(), part_faces.begin(), part_faces.end());
+      // A part with no other region around it is a whole component of the surface: there is nothing
+      // to give it to (with a speck area above the surface's, giving G away and then the whole
+      // surface back would never end).
+      large = large || !bordered;
       if (large) {
         for (auto f : part_faces) mark[std::size_t(f.idx())] = kLarge;
       } else {
