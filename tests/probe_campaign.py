@@ -56,6 +56,12 @@ class Campaign:
         counts = self.results.setdefault(cls, {})
         counts[outcome] = counts.get(outcome, 0) + 1
         if outcome != "ended well":
+            # The damaged inputs are rewritten by the next probe: keep this one's, to reproduce it.
+            for a in args:
+                if a.startswith(("cut.", "flip.")) and (self.work / a).exists():
+                    kept = self.work / f"kept_{len(self.failures)}_{a}"
+                    kept.write_bytes((self.work / a).read_bytes())
+                    args = [str(kept.name) if x == a else x for x in args]
             self.failures.append(f"{cls}: bodyfit {' '.join(args)} -> {outcome} ({time.time() - start:.1f} s)\n"
                                  f"    {err.strip()[-300:]}")
         if expect_file:

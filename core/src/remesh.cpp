@@ -4,8 +4,10 @@
 // class is in remesher.hpp, its operators, features and repair in remesh_*.cpp.
 #include "remesher.hpp"
 
+#include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
@@ -95,6 +97,11 @@ void Remesher::work_edges(std::vector<EdgeHandle>& edges) const {
 void Remesher::split_long_edges() {
   work_edges(edges_);
   std::vector<VertexHandle> created;
+  // No size is below hmin, so edges of hmin covering the surface bound what splitting can make (4×
+  // for the gradation and the rounds' leftovers): beyond, splits no longer bring triangles to size
+  // (a needle to a far vertex, split along its length into ever more needles) and would not end.
+  const double area = total_area(m_);
+  const double bound = 4 * faces_for_edge_length(area, hmin_) + 2.0 * double(m_.n_faces());
   while (true) {
     ranked_.clear();
     for (auto e : edges_)
@@ -112,6 +119,12 @@ void Remesher::split_long_edges() {
     // The budget checked before the remesh counts faces of hmax; curvature and hausd may ask for
     // far smaller edges (a spike, a tiny hausd): the growth itself is bounded, round by round.
     check_face_budget(double(m_.n_faces() + 2 * k), "remesh: the sizes the curvature and hausd ask for");
+    if (double(m_.n_faces() + 2 * k) > bound)
+      throw InputError(fmt::format(
+          "remesh: splitting to the sizes asked for would make over {:.3g} faces, more than edges of hmin = {:.3g} "
+          "cover the surface's area ({:.3g}) with: triangles the splits cannot bring to size (a vertex far from the "
+          "others, needles; worst quality {:.3g}) — check the input",
+          double(m_.n_faces() + 2 * k), hmin_, area, quality_stats(m_).min));
     m_.reserve(m_.n_vertices() + k, m_.n_edges() + 3 * k, m_.n_faces() + 2 * k);
     const std::size_t before = report_.splits;
     created.clear();
