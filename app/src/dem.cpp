@@ -22,7 +22,9 @@
 #include <iterator>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -53,6 +55,17 @@ void check_heights(const HeightGrid& grid, const std::filesystem::path& file) {
 // would otherwise carry pits 10 km deep (the fire then ran down them without a word).
 constexpr double kMarkers[] = {-9999.0, -99999.0, -32768.0, -32767.0, -3.4028234663852886e38};
 
+/// A warning about a raster, said once per process: a run reads its DEM more than once (the terrain,
+/// then its coordinate system; each ensemble member), and the same cells need naming only once.
+template <class... Args>
+void warn_once(fmt::format_string<Args...> format, Args&&... args) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  std::string text = fmt::format(format, std::forward<Args>(args)...);
+  const std::lock_guard lock(mutex);
+  if (said.insert(text).second) spdlog::warn("{}", text);
+}
+
 /// An undeclared marker becomes NODATA; a cell standing alone far off its neighbours (a spike or a
 /// pit: a damaged cell, a tower in a surface model) takes their median. Both said, naming cells.
 void screen_heights(HeightGrid& grid, const std::filesystem::path& file) {
@@ -67,7 +80,7 @@ void screen_heights(HeightGrid& grid, const std::filesystem::path& file) {
     ++marked;
   }
   if (marked)
-    spdlog::warn("{}: {} cell(s) hold a NODATA marker the header does not declare (its NODATA_value is {}), taken as "
+    warn_once("{}: {} cell(s) hold a NODATA marker the header does not declare (its NODATA_value is {}), taken as "
                  "NODATA: {}{}",
                  file.string(), marked, grid.nodata, fmt::join(markers, "; "), marked > markers.size() ? "; ..." : "");
   require_some_data(grid, file);
@@ -122,7 +135,7 @@ void screen_heights(HeightGrid& grid, const std::filesystem::path& file) {
       ++despiked;
     }
   if (despiked)
-    spdlog::warn("{}: {} cell(s) stand alone {:.3g} or more off the median of their neighbours (more than 30 times "
+    warn_once("{}: {} cell(s) stand alone {:.3g} or more off the median of their neighbours (more than 30 times "
                  "the grid's roughness and 3 cells' size, and 5 times any neighbour's), taken as damaged and given "
                  "that median: {}{}",
                  file.string(), despiked, threshold, fmt::join(spikes, "; "), despiked > spikes.size() ? "; ..." : "");
@@ -259,7 +272,7 @@ void require_metres(const HeightGrid& grid, const std::filesystem::path& file) {
                   file.string(), zone.zone, zone.north ? 'N' : 'S');
   if (grid.crs.empty()) {
     if (grid.cell_size < 0.01 && west >= -180 && east <= 180 && south >= -90 && north <= 90)
-      spdlog::warn("{}: no coordinate system (no .prj) and cells of {} m: if these are degrees, project the raster "
+      warn_once("{}: no coordinate system (no .prj) and cells of {} m: if these are degrees, project the raster "
                    "first, e.g. `{}",
                    file.string(), grid.cell_size, projection);
     return;
