@@ -25,11 +25,14 @@ from ._bodyfit import (  # noqa: F401  (the public names)
     Step,
     advect,
     discretize,
+    plane,
     read,
     read_field,
     remesh,
+    set_log_level,
     set_threads,
     signed_distance,
+    sphere,
     write_field,
 )
 
@@ -38,9 +41,9 @@ __version__ = _bodyfit.__version__
 __all__ = [
     "Error", "InputError", "IoError", "NumericalError", "PluginError",
     "Mesh", "Step", "Parameter", "Output", "Review", "RunResult",
-    "read", "read_field", "write_field", "from_meshio",
+    "read", "read_field", "write_field", "from_meshio", "sphere", "plane",
     "signed_distance", "advect", "discretize", "remesh", "info",
-    "run", "set_threads", "build_info",
+    "run", "set_threads", "set_log_level", "build_info",
 ]
 
 

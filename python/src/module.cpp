@@ -8,6 +8,8 @@
 #include <bodyfit/app/stages.hpp>
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
+#include <bodyfit/generators.hpp>
+#include <bodyfit/guards.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/plugin_loader.hpp>
 
@@ -526,6 +528,45 @@ Returns a new Mesh; InputError when the sizes would make more faces than the bud
         py::arg("resume"), py::arg("overwrite"), py::arg("force"), py::arg("verbose"));
 
   m.def(
+      "sphere",
+      [](std::size_t faces, double radius) {
+        require(faces >= 20, fmt::format("faces: {} is below 20", faces));
+        require(std::isfinite(radius) && radius > 0, fmt::format("radius: {} is not a finite number > 0", radius));
+        check_face_budget(double(faces), "sphere");
+        SurfaceMesh mesh;
+        {
+          py::gil_scoped_release release;  // the Mesh (a Python dict inside) is made with the GIL
+          mesh = make_sphere({.faces = faces, .radius = radius});
+        }
+        return wrap(std::move(mesh));
+      },
+      py::arg("faces") = SphereOptions{}.faces, py::arg("radius") = SphereOptions{}.radius,
+      R"(A geodesic sphere of about `faces` triangles (within ±10 %), vertices exactly on it, as `bodyfit mesh sphere`.)");
+  m.def(
+      "plane",
+      [](double size, double h) {
+        require(std::isfinite(size) && size > 0, fmt::format("size: {} is not a finite number > 0", size));
+        require(std::isfinite(h) && h > 0, fmt::format("h: {} is not a finite number > 0", h));
+        check_face_budget(faces_for_edge_length(size * size, h), "plane");
+        SurfaceMesh mesh;
+        {
+          py::gil_scoped_release release;
+          mesh = make_plane({.size = size, .h = h});
+        }
+        return wrap(std::move(mesh));
+      },
+      py::arg("size") = PlaneOptions{}.size, py::arg("h") = PlaneOptions{}.h,
+      R"(The square [-size/2, size/2]² at z = 0 with near-equilateral triangles of edge ≈ h (an open surface).)");
+  m.def(
+      "set_log_level",
+      [](const std::string& level) {
+        const auto parsed = spdlog::level::from_str(level);
+        require(parsed != spdlog::level::off || level == "off",
+                fmt::format("set_log_level: '{}', expected trace, debug, info, warning, error, critical or off", level));
+        spdlog::set_level(parsed);
+      },
+      py::arg("level"), "The engine's messages shown: 'info' (the default), 'warning', 'error', 'off', ...");
+  m.def(
       "set_threads",
       [](int n) {
         static std::unique_ptr<tbb::global_control> limit;
@@ -545,5 +586,4 @@ Returns a new Mesh; InputError when the sizes would make more faces than the bud
     d["cores"] = tbb::info::default_concurrency();
     return d;
   });
-  m.def("_set_log_level", [](const std::string& level) { spdlog::set_level(spdlog::level::from_str(level)); });
 }

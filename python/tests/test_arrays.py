@@ -160,3 +160,21 @@ def test_every_option_is_documented_and_stubbed():
         assert stub_defaults.keys() == defaults.keys(), stage.__name__
         for name, value in defaults.items():
             assert ast.literal_eval(stub_defaults[name]) == ast.literal_eval(value), f"{stage.__name__}: {name}"
+
+
+def test_generators_and_log_level():
+    sphere = bodyfit.sphere(faces=2000, radius=2.0)
+    assert abs(sphere.n_faces - 2000) <= 200
+    np.testing.assert_allclose(np.linalg.norm(sphere.vertices, axis=1), 2.0, rtol=1e-12)
+    assert bodyfit.info(sphere)["area"] == pytest.approx(16 * np.pi, rel=0.01)
+    square = bodyfit.plane(size=1.0, h=0.1)
+    assert bodyfit.info(square)["area"] == pytest.approx(1.0, rel=1e-9)
+    assert bodyfit.info(square)["boundary_loops"]["count"] == 1
+    with pytest.raises(bodyfit.InputError, match="faces: 3 is below 20"):
+        bodyfit.sphere(faces=3)
+    with pytest.raises(bodyfit.InputError, match="h: -1"):
+        bodyfit.plane(h=-1)
+    bodyfit.set_log_level("warning")
+    bodyfit.set_log_level("info")
+    with pytest.raises(bodyfit.InputError, match="expected trace"):
+        bodyfit.set_log_level("loud")
