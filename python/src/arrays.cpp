@@ -101,6 +101,10 @@ std::vector<std::int64_t> checked_integers(py::handle value, const std::string& 
   return std::vector<std::int64_t>(d.data(), d.data() + d.size());
 }
 
+void require(bool ok, const std::string& what) {
+  if (!ok) throw InputError(what);
+}
+
 std::string describe(const py::error_already_set& error) {
   try {
     py::object format = py::module_::import("traceback").attr("format_exception");

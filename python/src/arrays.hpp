@@ -40,6 +40,9 @@ VectorField vector_field(py::handle value, const std::string& what, std::size_t 
 /// An integer array (any integer dtype) of `columns` columns as int64.
 std::vector<std::int64_t> checked_integers(py::handle value, const std::string& what, std::size_t columns);
 
+/// InputError(`what`) unless `ok`: the module's checks of arguments.
+void require(bool ok, const std::string& what);
+
 /// The Python exception being handled, as text: its type, message and traceback.
 std::string describe(const py::error_already_set& error);
 
