@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   args.option("--meshes", names);
   args.option("-o", csv_path);
   args.parse(argc, argv);
+  if (!std::filesystem::is_directory(dir)) args.fail(dir.string() + ": no such directory (scripts/setup.sh extracts the meshes)");
   if (names.empty()) {
     for (const auto& entry : std::filesystem::directory_iterator(dir))
       if (entry.path().extension() == ".off") names.push_back(entry.path().filename().string());
@@ -150,8 +151,16 @@ int main(int argc, char** argv) {
          "sharp_length_in,sharp_length_out,self_intersections_in,self_intersections_out,ms\n";
   std::printf("%-22s %8s %8s %6s %6s %6s %9s %9s %8s %10s %10s %6s %6s %8s\n", "mesh", "in", "out", "q_in", "q_min",
               "q_mean", "out→in", "in→out", "area %", "sharp in", "sharp out", "x in", "x out", "ms");
+  int failed = 0;
   for (const std::string& name : names) {
-    SurfaceMesh input = read_mesh(dir / name);
+    SurfaceMesh input;
+    try {
+      input = read_mesh(dir / name);
+    } catch (const std::exception& e) {  // a mesh that cannot be read is reported, the others measured
+      std::fprintf(stderr, "bench_real_meshes: %s\n", e.what());
+      ++failed;
+      continue;
+    }
     SurfaceMesh output = input;
     const auto start = std::chrono::steady_clock::now();
     remesh_stage(output, RemeshOptions{});
@@ -173,4 +182,5 @@ int main(int argc, char** argv) {
         << sharp_out << ',' << x_in << ',' << x_out << ',' << ms << '\n';
   }
   std::printf("-> %s\n", csv_path.string().c_str());
+  return failed ? 1 : 0;
 }
