@@ -24,9 +24,10 @@ VtuFields vtu_fields(const Mesh& m) {
   VtuFields out;
   for (auto [key, value] : m.fields) {
     const std::string name = py::str(key);
-    auto a = py::reinterpret_borrow<py::array>(value);
-    if (a.ndim() == 2) out.point_vectors.emplace_back(name, vector_field(value, "field " + name, m.n_vertices()));
-    else out.point_scalars.emplace_back(name, scalar_field(value, "field " + name, m.n_vertices()));
+    if (py::isinstance<py::array>(value) && py::reinterpret_borrow<py::array>(value).ndim() == 2)
+      out.point_vectors.emplace_back(name, vector_field(value, "field " + name, m.n_vertices()));
+    else
+      out.point_scalars.emplace_back(name, scalar_field(value, "field " + name, m.n_vertices()));
   }
   return out;
 }

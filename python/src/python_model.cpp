@@ -209,6 +209,8 @@ VelocityField velocity_of(py::handle result, std::size_t n) {
     field = VelocityField::normal(scalar_field(v, "compute(): the normal speed", n));
   if (extra.contains("metrics")) field.metrics = metrics_of(extra["metrics"], "compute(): metrics");
   if (extra.contains("fields")) {
+    if (!py::isinstance<py::dict>(extra["fields"]))
+      throw InputError(fmt::format("compute(): fields: a dict of arrays expected, got a {}", type_name(extra["fields"])));
     for (auto [key, value] : py::reinterpret_borrow<py::dict>(extra["fields"])) {
       const std::string name = py::str(key);
       if (py::isinstance<py::array>(value) && py::reinterpret_borrow<py::array>(value).ndim() == 2)

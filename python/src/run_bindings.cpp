@@ -128,6 +128,9 @@ py::dict run(py::object case_, std::optional<std::filesystem::path> out, py::obj
     }
   }
   if (!set.is_none()) {
+    if (!py::isinstance<py::dict>(set))
+      throw InputError(fmt::format("run(): set: a dict {{\"dotted.key\": value}} expected, got a {}",
+                                   std::string(py::str(set.get_type().attr("__name__")))));
     for (auto [key, value] : py::reinterpret_borrow<py::dict>(set)) {
       toml::table one;
       one.insert("v", *toml_of(value, py::str(key)));

@@ -178,3 +178,16 @@ def test_generators_and_log_level():
     bodyfit.set_log_level("info")
     with pytest.raises(bodyfit.InputError, match="expected trace"):
         bodyfit.set_log_level("loud")
+
+
+def test_values_of_the_wrong_kind_are_refused(tmp_path):
+    mesh = bodyfit.sphere(faces=500)
+    mesh.fields["x"] = [1.0, 2.0]
+    with pytest.raises(bodyfit.InputError, match="field x: a numpy array"):
+        mesh.write(tmp_path / "m.vtu")
+    case = {"surface": {"generator": "sphere", "h": 0.2}, "region": {"shape": "cap", "angle": 45.0},
+            "model": {"name": "conormal"}, "time": {"dt": 0.1, "final_time": 0.1}}
+    with pytest.raises(bodyfit.InputError, match="set: a dict"):
+        bodyfit.run(case, out=tmp_path / "out", set=["time.dt=0.05"], progress=False)
+    with pytest.raises(bodyfit.InputError, match="a set cannot go into a case"):
+        bodyfit.run(case, out=tmp_path / "out2", set={"time.dt": {0.1}}, progress=False)
