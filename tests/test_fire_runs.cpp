@@ -64,6 +64,7 @@ FireRun burn(SurfaceMesh surface, const std::vector<std::array<double, 3>>& disk
   remesh.hmax = edge_length_stats(surface).mean;
   remesh.hausd = hausd;
   remesh.reference = std::make_shared<ReferenceSurface>(surface);
+  remesh.check_distance_to_reference = false;  // as a case on a terrain (setup_case)
   mesh_initial_region(surface, phi, {}, remesh);
 
   LoadedModel model = load_plugin_file(std::filesystem::path(BODYFIT_PLUGIN_DIR) / "bodyfit_fire.so");

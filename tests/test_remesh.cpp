@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
 
 #include "test_support.hpp"
@@ -851,4 +852,77 @@ TEST_CASE("ridges are detected only where S has a crease too: a bump of the mesh
   for (auto e : cube.edges())
     if (cube.ridge(e)) ridge_length += edge_length(cube, e);
   CHECK(ridge_length == doctest::Approx(24).epsilon(1e-12));
+}
+
+TEST_CASE("a faceted part: triangles never cut across its creases below the ridge angle by more than hausd") {
+  // A prism of 10 facets (creases of 36°, below the 45° ridge angle: no feature) with open ends, each
+  // facet a strip of long thin triangles as CAD tessellations are, coarsened 3×: the curvature
+  // estimated at the vertices does not see the creases, and triangles across them would pass 8 hausd
+  // from the facets.
+  const int sides = 10, across = 1, along = 24;
+  const double length = 2;
+  SurfaceMesh mesh;
+  std::vector<VertexHandle> vh;
+  for (int j = 0; j <= along; ++j)
+    for (int i = 0; i < sides * across; ++i) {
+      const int side = i / across, k = i % across;
+      auto corner = [&](int s) {
+        const double angle = 2 * std::numbers::pi * s / sides;
+        return Vec3(std::cos(angle), std::sin(angle), 0);
+      };
+      Vec3 p = corner(side) + (corner(side + 1) - corner(side)) * (double(k) / across);
+      p[2] = length * j / along;
+      vh.push_back(mesh.add_vertex(p));
+    }
+  const int ring = sides * across;
+  for (int j = 0; j < along; ++j)
+    for (int i = 0; i < ring; ++i) {
+      auto a = vh[std::size_t(j * ring + i)], b = vh[std::size_t(j * ring + (i + 1) % ring)];
+      auto c = vh[std::size_t((j + 1) * ring + (i + 1) % ring)], d = vh[std::size_t((j + 1) * ring + i)];
+      mesh.add_face(a, b, c);
+      mesh.add_face(a, c, d);
+    }
+  for (auto f : mesh.faces()) mesh.region(f) = kOutside;
+  const ReferenceSurface facets(mesh);
+  const double hausd = bounding_box(mesh).diagonal() / 1000;
+  // How far the mesh strays from the facets: its vertices, edge middles and face centroids.
+  auto strays = [&](const SurfaceMesh& m) {
+    double worst = 0;
+    auto from_facets = [&](const Vec3& p) { worst = std::max(worst, (facets.closest(p).point - p).norm()); };
+    for (auto v : m.vertices()) from_facets(m.point(v));
+    for (auto e : m.edges()) {
+      auto h = m.halfedge_handle(e, 0);
+      from_facets((m.point(m.from_vertex_handle(h)) + m.point(m.to_vertex_handle(h))) / 2.0);
+    }
+    for (auto f : m.faces()) {
+      Vec3 c(0, 0, 0);
+      for (auto v : m.fv_range(f)) c += m.point(v) / 3.0;
+      from_facets(c);
+    }
+    return worst;
+  };
+  RemeshOptions options;
+  options.hmax = 3 * edge_length_stats(mesh).mean;
+  SurfaceMesh checked = mesh, unchecked = mesh;
+  const auto report = remesh(checked, options);
+  CHECK(report.collapses > 0);
+  CHECK(problems(checked) == "");
+  options.check_distance_to_reference = false;
+  remesh(unchecked, options);
+  const double with = strays(checked), without = strays(unchecked);
+  MESSAGE("strays " << with / hausd << " hausd with the checks, " << without / hausd << " without");
+  CHECK(with <= 1.5 * hausd);
+  CHECK(without > 5 * hausd);  // what the checks prevent: the sizes alone do not see the creases
+  CHECK(total_area(checked) == doctest::Approx(total_area(mesh)).epsilon(1e-3));
+}
+
+TEST_CASE("ReferenceSurface::max_curvature: 1/R on a fine sphere, 0 on a plane, large across a crease") {
+  for (double radius : {0.5, 2.0}) {
+    const ReferenceSurface sphere(make_sphere({.faces = 20000, .radius = radius}));
+    CHECK(sphere.max_curvature() == doctest::Approx(1 / radius).epsilon(0.1));
+  }
+  CHECK(ReferenceSurface(make_grid(8, 1.0)).max_curvature() == 0);
+  const ReferenceSurface cube(make_cube(4));  // 90° creases between triangles 0.5 / 3 · √5 apart at most
+  CHECK(cube.max_curvature() > 3);
+  CHECK(ReferenceSurface::sphere(Vec3(0, 0, 0), 4)->max_curvature() == 0.25);
 }

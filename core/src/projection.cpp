@@ -168,15 +168,37 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
     points_.push_back(mesh.point(v));
   }
   vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
+  std::vector<int> face_index(mesh.n_faces(), -1);
   for (auto f : mesh.faces()) {
     std::array<int, 3> t{};
     int k = 0;
     for (auto v : mesh.fv_range(f)) t[k++] = index[v.idx()];
+    face_index[std::size_t(f.idx())] = int(tri_.size());
     tri_.push_back(t);
     const Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);
     const double len = n.norm();
     normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
     for (int i : t) vertex_normal_[std::size_t(i)] += n;  // weighted by twice the area
+  }
+  // The turn of the normal between two adjacent triangles per distance between their centroids: on
+  // a fine tessellation of a sphere of radius R, 1/R; across a crease, the crease's angle over a
+  // triangle's size.
+  for (auto e : mesh.edges()) {
+    if (mesh.is_boundary(e)) continue;
+    const int f0 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(e, 0)).idx())];
+    const int f1 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(e, 1)).idx())];
+    const Vec3 &n0 = normal_[std::size_t(f0)], &n1 = normal_[std::size_t(f1)];
+    if (n0.sqrnorm() == 0 || n1.sqrnorm() == 0) {
+      max_curvature_ = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    auto centroid = [&](int f) {
+      const auto& t = tri_[std::size_t(f)];
+      return (points_[std::size_t(t[0])] + points_[std::size_t(t[1])] + points_[std::size_t(t[2])]) / 3.0;
+    };
+    const double turn = std::atan2((n0 % n1).norm(), n0 | n1);
+    const double apart = (centroid(f0) - centroid(f1)).norm();
+    max_curvature_ = std::max(max_curvature_, apart > 0 ? turn / apart : std::numeric_limits<double>::infinity());
   }
   for (Vec3& n : vertex_normal_) {
     const double len = n.norm();

@@ -289,6 +289,12 @@ RemeshReport Remesher::run() {
   auto start = std::chrono::steady_clock::now();
   setup_sizes();
   ref_ = opt_.reference ? opt_.reference : std::make_shared<const ReferenceSurface>(m_);
+  // Not needed where no chord the passes may make (up to twice hmax) can stray beyond hausd/2 from S
+  // (a fine tessellation of a smooth surface, a plane): the checks' projections cost a third of a
+  // remesh.
+  const double longest = 2 * hmax_;
+  check_distance_ = opt_.check_distance_to_reference && !ref_->analytic() &&
+                    longest * longest * ref_->max_curvature() / 8 > hausd_ / 2;
   const bool debug = spdlog::should_log(spdlog::level::trace);  // bodyfit -vv
   timespec cpu_start{};
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu_start);

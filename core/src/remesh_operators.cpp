@@ -141,6 +141,43 @@ bool Remesher::folds(std::span<const std::array<VertexHandle, 3>> triangles, std
   return false;
 }
 
+// Whether the point p of S stays within hausd of the triangles (vertex positions; `moved` at `at`).
+// A point the change removes from the mesh (a collapsed vertex, the middle of a flipped diagonal
+// projected on S, a relocated vertex's old place) measures how far the new triangles leave S there.
+// Asked only against a reference made of triangles (RemeshOptions::check_distance_to_reference): on
+// an analytic S the sizes from its exact curvature bound the sag, but the curvature estimated on a
+// faceted CAD part or a scan misses the creases below the ridge angle, where triangles would cut
+// across (docs/validation/real_meshes.md).
+bool Remesher::near_surface(const Vec3& p, std::span<const std::array<VertexHandle, 3>> triangles, VertexHandle moved,
+                            const Vec3& at) const {
+  return !check_distance_ || distance_to(p, triangles, moved, at) <= hausd_;
+}
+
+double Remesher::distance_to(const Vec3& p, std::span<const std::array<VertexHandle, 3>> triangles, VertexHandle moved,
+                             const Vec3& at) const {
+  auto position = [&](VertexHandle v) -> const Vec3& { return v == moved ? at : m_.point(v); };
+  double d2 = std::numeric_limits<double>::infinity();
+  for (const auto& t : triangles)
+    d2 = std::min(d2, (closest_point_on_triangle(p, position(t[0]), position(t[1]), position(t[2])) - p).sqrnorm());
+  return std::sqrt(d2);
+}
+
+// How far the middle of the chord (a, b) is from S (0 when not checked): a new edge across a crease
+// the sizes do not see would cut through the part.
+double Remesher::chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) const {
+  if (!check_distance_) return 0;
+  const Vec3 mid = (a + b) * 0.5;
+  return (ref_->closest(mid, m_.property(hint_, near)).point - mid).norm();
+}
+
+// Whether the chord (a, b) replacing the chord (a_old, b_old) stays within hausd of S, or sags no
+// more than the one it replaces.
+bool Remesher::chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old,
+                                  const Vec3& b_old) const {
+  const double sag = chord_sag(near, a, b);
+  return sag <= hausd_ || sag <= chord_sag(near, a_old, b_old);
+}
+
 // Whether the curve stays within hausd (the interface: hausd_interface) of the curve vertex v0 when
 // it collapses along h onto v1: the new curve edge (u, v1), u the other curve neighbour of v0, must
 // pass within that distance of v0.
@@ -211,6 +248,9 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change, Rule rule) const
     if (l > kSplitRatio * target(v1, w) && l > (m_.point(w) - m_.point(v0)).norm()) return false;
   }
   if (folds(after, star)) return false;
+  if (!near_surface(m_.point(v0), after)) return false;
+  for (auto w : m_.vv_range(v0))
+    if (w != v1 && !chord_within_hausd(v1, p1, m_.point(w), m_.point(v0), m_.point(w))) return false;
   change.old_min = old_min;
   change.new_min = new_min;
   return true;
@@ -298,7 +338,16 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   if ((t0.normal | n) < min_cos || (t1.normal | n) < min_cos) return false;
   const std::array<std::array<VertexHandle, 3>, 2> after{{{a, d, c}, {b, c, d}}};
   const std::array<FaceHandle, 2> replaced{m_.face_handle(h0), m_.face_handle(h1)};
-  return !folds(after, replaced);
+  if (folds(after, replaced)) return false;
+  // The diagonal's middle on S: the new pair must pass within hausd of it (or nearer than the old).
+  if (check_distance_) {
+    const Vec3 q = ref_->closest((pa + pb) * 0.5, m_.property(hint_, a)).point;
+    const std::array<std::array<VertexHandle, 3>, 2> before{{{a, b, c}, {b, a, d}}};
+    const double now = distance_to(q, after);
+    if (now > hausd_ && now > distance_to(q, before)) return false;
+    if (!chord_within_hausd(c, pc, pd, pa, pb)) return false;
+  }
+  return true;
 }
 
 void Remesher::flip_edge(EdgeHandle e) {
@@ -329,6 +378,15 @@ double Remesher::relocate(VertexHandle v) {
   SurfacePoint sp;
   Change change;
   if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change) || move_lengthens(v, q)) return 0;
+  if (check_distance_) {
+    std::vector<std::array<VertexHandle, 3>>& star = after_;
+    star.clear();
+    for (auto h : m_.voh_range(v))
+      if (!m_.is_boundary(h)) star.push_back({v, m_.to_vertex_handle(h), m_.to_vertex_handle(m_.next_halfedge_handle(h))});
+    if (!near_surface(p, star, v, q)) return 0;
+    for (auto w : m_.vv_range(v))
+      if (!chord_within_hausd(v, q, m_.point(w), p, m_.point(w))) return 0;
+  }
   // Curve vertices move only to repair a poor triangle: a point between the reference curve's
   // vertices lies on a chord, off the true curve by up to h²κ/8.
   if (kind == kCurveVertex && change.old_min >= kCurveRepairQuality) return 0;

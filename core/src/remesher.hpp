@@ -245,6 +245,12 @@ class Remesher {
   bool folds(std::span<const std::array<VertexHandle, 3>> triangles, std::span<const FaceHandle> replaced,
              VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
   bool move_lengthens(VertexHandle v, const Vec3& q) const;
+  bool near_surface(const Vec3& p, std::span<const std::array<VertexHandle, 3>> triangles,
+                    VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
+  double distance_to(const Vec3& p, std::span<const std::array<VertexHandle, 3>> triangles,
+                     VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
+  double chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) const;
+  bool chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old, const Vec3& b_old) const;
   std::size_t repair_slivers();
   std::vector<std::pair<double, FaceHandle>> slivers_;  // faces below kRepairBelow (final_sweep)
   bool repair(FaceHandle f);
@@ -268,6 +274,7 @@ class Remesher {
   SurfaceMesh& m_;
   RemeshOptions opt_;
   std::shared_ptr<const ReferenceSurface> ref_;
+  bool check_distance_ = false;  // every change kept within hausd of ref_'s triangles
   ReferencePolyline curves_;
   double hmin_ = 0, hmax_ = 0, hausd_ = 0, interface_hausd_ = 0, corner_angle_ = 0;
   RemeshReport report_;

@@ -42,6 +42,11 @@ class ReferenceSurface {
   /// Radius of the analytic sphere (0 for a triangle reference).
   double sphere_radius() const { return is_sphere_ ? radius_ : 0.0; }
   std::size_t n_triangles() const { return tri_.size(); }
+  /// An upper estimate of S's normal curvature: the largest turn of the normal between two adjacent
+  /// triangles per distance between their centroids (1/R on a fine tessellation of a sphere, 0 on a
+  /// plane, large across a crease). A chord of length L between points of S then passes within
+  /// L²·max_curvature()/8 of S.
+  double max_curvature() const { return is_sphere_ ? 1.0 / radius_ : max_curvature_; }
 
  private:
   ReferenceSurface() = default;
@@ -49,6 +54,7 @@ class ReferenceSurface {
   bool is_sphere_ = false;
   Vec3 center_{0, 0, 0};
   double radius_ = 1;
+  double max_curvature_ = 0;
   std::vector<Vec3> points_;
   std::vector<std::array<int, 3>> tri_;
   std::vector<Vec3> normal_;

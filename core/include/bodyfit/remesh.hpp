@@ -42,6 +42,15 @@ struct RemeshOptions {
   /// The fixed surface S onto which new and moved vertices are projected; when null the input
   /// mesh itself is used as reference.
   std::shared_ptr<const ReferenceSurface> reference;
+  /// Keep every change within hausd of a reference made of triangles: a collapse, flip or move is
+  /// refused when a point it removes from the mesh, or the middle of an edge it creates, would end
+  /// farther than hausd from S (unless no farther than before). The sizes come from an estimate of
+  /// S's curvature, which misses the creases of a faceted CAD part or a scan below the ridge angle;
+  /// these checks keep the triangles from cutting across them. An analytic S, or one whose
+  /// max_curvature() bends no chord of 2·hmax beyond hausd/2, needs none. A caller whose reference
+  /// is a sampled height field rather than a shape may turn them off: following every lattice bump
+  /// within hausd costs quality (docs/validation/real_meshes.md).
+  bool check_distance_to_reference = true;
   /// After a remesh that changed the connectivity, renumber the mesh in spatial order
   /// (reorder_spatially) when it has become scattered in memory (spatial_disorder above 10 %);
   /// otherwise, and when false, only collect the garbage (collect_garbage).
