@@ -392,6 +392,38 @@ TEST_CASE("ensemble: a failing member is recorded with its error and the others 
   for (double p : probability.values) REQUIRE(p == std::round(p * ok) / ok);
 }
 
+TEST_CASE("ensemble: a grid whose frame differs from another process's first member stops at the first member") {
+  // The ranks of an MPI ensemble share the output directory: the first member any of them finishes
+  // publishes its grids' frames there (frames/NAME.frame), and a rank whose first member's grid
+  // differs stops then, not at the reduction after every member ran. Here another process published
+  // a frame of other cells.
+  TempDir dir("ensemble_frames");
+  const fs::path case_file = write_case(dir);
+  fs::create_directories(dir / "out" / "frames");
+  std::ofstream(dir / "out" / "frames" / "arrival_time.frame") << "7 5 123.5 0 0 17\n";
+  const auto result =
+      run_bodyfit(fmt::format("--threads 1 ensemble {} -o {} --members 40", case_file.string(), (dir / "out").string()));
+  INFO(result.output);
+  CHECK(result.exit_code == 1);
+  CHECK(result.output.find("members 17 and 0: their 'arrival_time' grids differ (7 × 5 cells of 123.5") !=
+        std::string::npos);
+  std::size_t grids = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "out" / "members"))
+    grids += entry.path().filename().string().find("arrival_time") != std::string::npos;
+  CHECK(grids == 0);
+  // A frame file that is not one is named with what it should hold.
+  std::ofstream(dir / "out" / "frames" / "arrival_time.frame") << "seven\n";
+  const auto damaged =
+      run_bodyfit(fmt::format("--threads 1 ensemble {} -o {} --members 40", case_file.string(), (dir / "out").string()));
+  CHECK(damaged.exit_code == 6);  // the output directory's problem (an I/O error)
+  CHECK_MESSAGE(damaged.output.find("arrival_time.frame:1: expected the frame of a grid") != std::string::npos,
+                damaged.output);
+  // A complete ensemble leaves no frames behind (its files are the same bytes however it ran).
+  fs::remove_all(dir / "out");
+  ensemble(case_file, dir / "out", "--members 2");
+  CHECK(!fs::exists(dir / "out" / "frames"));
+}
+
 TEST_CASE("ensemble: under MPI, 1 and 2 ranks give the sequential bytes") {
   if constexpr (!config::have_mpi) {
     MESSAGE("built without MPI: skipped");

@@ -15,9 +15,14 @@
 #include <spdlog/spdlog.h>
 #include <toml++/toml.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <sstream>
 
 namespace bodyfit {
@@ -29,21 +34,54 @@ struct GridsDiffer : InputError {
   using InputError::InputError;
 };
 
+[[noreturn]] void grids_differ(const EnsembleRun& run, const std::string& name, const HeightGrid& frame,
+                               std::size_t frame_index, const HeightGrid& grid, std::size_t index) {
+  throw GridsDiffer(fmt::format("members {} and {}: their '{}' grids differ ({} × {} cells of {} at ({}, {}) against {} "
+                                "× {} of {} at ({}, {})): the grid depends on a sampled parameter; give the model a "
+                                "grid that does not (bodyfit plugins --describe {} names its parameters)",
+                                frame_index, index, name, frame.cols, frame.rows, frame.cell_size, frame.x_origin,
+                                frame.y_origin, grid.cols, grid.rows, grid.cell_size, grid.x_origin, grid.y_origin,
+                                run.model));
+}
+
+/// The frame of the first member any process of the ensemble finished, kept in the output directory
+/// (which the ranks of an MPI ensemble share), so that ranks whose members' grids differ stop after
+/// their first members rather than at the reduction, after every member ran. The first process to
+/// finish a member publishes its frame with link(), which fails when another did first.
+void check_frame_of_other_processes(const EnsembleRun& run, const std::string& name, const HeightGrid& grid,
+                                    std::size_t index) {
+  const std::filesystem::path dir = run.outdir / "frames", file = dir / (name + ".frame");
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path tmp = dir / fmt::format(".{}.m{:06d}.tmp", name, index);
+  write_atomically(tmp, [&](std::ostream& out) {
+    out << fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", grid.cols, grid.rows, grid.cell_size, grid.x_origin,
+                       grid.y_origin, index);
+  });
+  const int linked = ::link(tmp.c_str(), file.c_str());
+  const int error = errno;
+  std::filesystem::remove(tmp);
+  if (linked == 0) return;
+  if (error != EEXIST) throw IoError(fmt::format("{}: {}", file.string(), std::strerror(error)));
+  std::ifstream in(file);
+  HeightGrid frame;
+  std::size_t frame_index = 0;
+  if (!(in >> frame.cols >> frame.rows >> frame.cell_size >> frame.x_origin >> frame.y_origin >> frame_index))
+    throw IoError(fmt::format("{}:1: expected the frame of a grid (columns, rows, cell size, origin, member); "
+                              "remove the file to start the frames over",
+                              file.string()));
+  if (!same_frame(frame, grid)) grids_differ(run, name, frame, frame_index, grid, index);
+}
+
 void check_same_frame(const EnsembleRun& run, const std::string& name, const HeightGrid& grid, std::size_t index) {
   std::lock_guard lock(run.frames->mutex);
   auto [it, first] = run.frames->first.try_emplace(name, grid, index);
   if (first) {
     it->second.first.heights.clear();  // the frame only
+    check_frame_of_other_processes(run, name, grid, index);
     return;
   }
   const HeightGrid& frame = it->second.first;
-  if (same_frame(frame, grid)) return;
-  throw GridsDiffer(fmt::format("members {} and {}: their '{}' grids differ ({} × {} cells of {} at ({}, {}) against {} "
-                                "× {} of {} at ({}, {})): the grid depends on a sampled parameter; give the model a "
-                                "grid that does not (bodyfit plugins --describe {} names its parameters)",
-                                it->second.second, index, name, frame.cols, frame.rows, frame.cell_size,
-                                frame.x_origin, frame.y_origin, grid.cols, grid.rows, grid.cell_size, grid.x_origin,
-                                grid.y_origin, run.model));
+  if (!same_frame(frame, grid)) grids_differ(run, name, frame, it->second.second, grid, index);
 }
 
 namespace fs = std::filesystem;

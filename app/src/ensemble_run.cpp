@@ -157,6 +157,8 @@ EnsembleSummary run_ensemble(const EnsembleOptions& options, const ProcessGroup&
 
   summary.reduced = reduce_ensemble(run);
   summary.reduced_here = true;
+  std::error_code ec;
+  fs::remove_all(options.outdir / "frames", ec);  // the members' grid frames, compared while they ran
   return summary;
 }
 
