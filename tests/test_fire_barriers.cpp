@@ -234,6 +234,21 @@ TEST_CASE("coordinate systems: a model raster in another system than the DEM's i
   CHECK_NOTHROW(configure_model(fourth, toml::parse(fmt::format("[fuel]\nmap = '{}'\n", (dir / "fuel_none.asc").string())), surface));
 }
 
+TEST_CASE("a fuel map is read as it is: a lone cell of another code is the map's, not a damaged height") {
+  // 1 m cells: a lone code 7 among 1s stands 6 off its neighbours, twice the 3 cells' size beyond
+  // which a DEM's lone cell is taken for a damaged one and given their median. In a fuel map it is
+  // data: here a code the presets do not have, which the model must name rather than burn as 1.
+  bodyfit::test::TempDir dir("fire_fuel_lone_cell");
+  HeightGrid fuel;
+  fuel.cols = fuel.rows = 8, fuel.cell_size = 1;
+  fuel.heights.assign(64, 1.0);
+  fuel.heights[3 * 8 + 4] = 7;
+  write_raster(dir / "fuel.asc", fuel);
+  LoadedModel model = fire_model();
+  CHECK_THROWS_WITH_AS(configure_model(model, toml::parse(fmt::format("[fuel]\nmap = '{}'\n", (dir / "fuel.asc").string()))),
+                       doctest::Contains("the fuel code 7 of the cell at row 4, column 5"), InputError);
+}
+
 TEST_CASE("coordinate systems: the outputs carry the DEM's system without [model.arrival] like") {
   if (!config::have_gdal) return;
   bodyfit::test::TempDir dir("fire_crs_outputs");

@@ -267,6 +267,14 @@ TEST_CASE("DEM outliers: an undeclared NODATA marker is NODATA, a lone spike or 
     for (int c = 0; c < cols; ++c)
       if (grid.valid(std::size_t(r), std::size_t(c)) && grid.at(std::size_t(r), std::size_t(c)) != height(r, c)) ++changed;
   CHECK(changed == 2);  // the cliff stays, and so does every other cell
+  // The same cells as a raster of values (a fuel map, a wind grid): read as they are.
+  const HeightGrid values = read_raster(dir / "dem.asc");
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      CAPTURE(r);
+      CAPTURE(c);
+      CHECK(values.at(std::size_t(r), std::size_t(c)) == z[std::size_t(r * cols + c)]);
+    }
   // The shipped DEMs (a real one among them) come back exactly as written.
   for (const char* name : {"hill.asc", "luxembourg_elev_200m.asc"}) {
     CAPTURE(name);

@@ -507,6 +507,23 @@ HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& opt
   return grid;
 }
 
+HeightGrid read_raster(const std::filesystem::path& file, const DemReadOptions& options) {
+  const std::string ext = lower(file.extension().string());
+  HeightGrid grid;
+  if (ext == ".asc") {
+    grid = read_esri_ascii_values(file);
+  } else if (ext == ".tif" || ext == ".tiff") {
+    std::string error;
+    if (!gis::module_for(file).read_raster(file, grid, error)) throw file_error(file, error);
+  } else {
+    throw file_error(file, "unknown raster format: expected .asc (ESRI ASCII grid) or .tif/.tiff (GeoTIFF)");
+  }
+  require_some_data(grid, file);
+  if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file, options);
+  require_metres(grid, file);
+  return grid;
+}
+
 HeightGrid read_landscape_band(const std::filesystem::path& file, LandscapeBand band, const DemReadOptions& options) {
   HeightGrid grid = read_landscape_band_as_is(file, band);
   if (options.reproject == Reprojection::utm) grid = reproject_to_utm(std::move(grid), file, options);

@@ -179,7 +179,7 @@ PlacementDomain make_placement_domain(const std::filesystem::path& case_file, co
     domain.xmin = std::min(domain.xmin, p[0]), domain.xmax = std::max(domain.xmax, p[0]);
     domain.ymin = std::min(domain.ymin, p[1]), domain.ymax = std::max(domain.ymax, p[1]);
   }
-  if (!spec.region.mask.empty()) domain.mask = read_dem(spec.region.mask);
+  if (!spec.region.mask.empty()) domain.mask = read_raster(spec.region.mask);
   return domain;
 }
 

@@ -623,7 +623,7 @@ class FireModel final : public VelocityModel {
     DemReadOptions options;
     if (!surface_.reprojected_from.empty())
       options = {.reproject = Reprojection::utm, .target_crs = surface_.crs, .resampling = resampling};
-    HeightGrid grid = band ? read_landscape_band(file, *band, options) : read_dem(file, options);
+    HeightGrid grid = band ? read_landscape_band(file, *band, options) : read_raster(file, options);
     if (grid.crs.empty() && !surface_.crs.empty())
       spdlog::warn("{}: no coordinate system: its cells are taken as in the surface's ({})", file.string(),
                    crs_label(surface_.crs, surface_.file));

@@ -24,7 +24,7 @@ std::string map_key(int k) { return std::string(kClassKeys[k]) + "_map"; }
 // A moisture raster: percent per cell, each valid cell a percentage; NODATA cells take the nearest
 // valid value (a moisture field has no holes where there is fuel).
 HeightGrid read_moisture_raster(const std::filesystem::path& file, const RasterReader& read) {
-  HeightGrid grid = read ? read(file) : read_dem(file);
+  HeightGrid grid = read ? read(file) : read_raster(file);
   for (std::size_t row = 0; row < grid.rows; ++row)
     for (std::size_t col = 0; col < grid.cols; ++col) {
       if (!grid.valid(row, col)) continue;

@@ -42,7 +42,7 @@ std::string too_strong(double speed) {
 
 /// A wind raster: its NODATA cells take the nearest valid value (a wind field has no holes).
 HeightGrid read_wind_raster(const std::filesystem::path& file, const RasterReader& read) {
-  HeightGrid grid = read ? read(file) : read_dem(file);
+  HeightGrid grid = read ? read(file) : read_raster(file);
   if (const std::size_t filled = fill_nodata(grid))
     spdlog::warn("{}: {} NODATA cell(s) of {} filled with the nearest valid wind", file.string(), filled,
                  grid.heights.size());

@@ -33,7 +33,7 @@ struct WindSeries {
 /// strictly increasing. Errors are InputError "<file>:<line>: …".
 WindSeries read_wind_series(const std::filesystem::path& csv);
 /// How the model reads a raster (the fire model: checked against the surface's coordinate system,
-/// and warped like the DEM when the case reprojects it); empty: read_dem as it is.
+/// and warped like the DEM when the case reprojects it); empty: read_raster as it is.
 using RasterReader = std::function<HeightGrid(const std::filesystem::path&)>;
 
 /// `time,u_file,v_file`: raster names relative to the CSV, read like a wind grid (NODATA cells

@@ -73,6 +73,11 @@ HeightGrid read_geotiff(const std::filesystem::path& file);
 /// are kept as they are (a raster whose cells are all NODATA is an error). A geographic raster is
 /// refused, or reprojected on request.
 HeightGrid read_dem(const std::filesystem::path& file, const DemReadOptions& options = {});
+/// A raster of values that are not heights (fuel codes, winds, moistures, a mask): .asc or
+/// .tif/.tiff, read and reprojected as read_dem does, but with none of a terrain's screening: no
+/// undeclared NODATA marker, no lone cell taken for a damaged one (a lone water cell among timber
+/// is data), no range of heights. The model checks the values against what they mean.
+HeightGrid read_raster(const std::filesystem::path& file, const DemReadOptions& options = {});
 
 /// The bands of a FARSITE landscape (.lcp), in their order in the file.
 enum class LandscapeBand {
