@@ -7,13 +7,14 @@
 // input both ways (output vertices and face centroids to the input's triangles; input vertices to
 // the output's), in units of the default hausd (diagonal/1000), the change of area, the length of
 // sharp edges (dihedral angle above 45°) before and after, triangle pairs of the output that
-// intersect (not sharing a vertex), and the time.
+// intersect (beyond the vertices and edges they share), and the time.
 #include "bench_args.hpp"
 
 #include <bodyfit/app/stages.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/io.hpp>
 #include <bodyfit/projection.hpp>
+#include <bodyfit/self_intersections.hpp>
 
 #include <algorithm>
 #include <array>
@@ -52,77 +53,6 @@ double sharp_length(const SurfaceMesh& mesh) {
     if (OpenMesh::dot(a, b) < threshold) length += mesh.calc_edge_length(e);
   }
   return length;
-}
-
-using Triangle = std::array<Vec3, 3>;
-
-/// Whether two triangles overlap by more than `tolerance` along every axis of the separating-axis
-/// test (their normals, the 9 cross products of their edges, and the in-plane edge normals for the
-/// coplanar case).
-bool triangles_intersect(const Triangle& a, const Triangle& b, double tolerance) {
-  const Vec3 na = OpenMesh::cross(a[1] - a[0], a[2] - a[0]), nb = OpenMesh::cross(b[1] - b[0], b[2] - b[0]);
-  std::vector<Vec3> axes{na, nb};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) axes.push_back(OpenMesh::cross(a[(i + 1) % 3] - a[i], b[(j + 1) % 3] - b[j]));
-  for (int i = 0; i < 3; ++i) {
-    axes.push_back(OpenMesh::cross(na, a[(i + 1) % 3] - a[i]));
-    axes.push_back(OpenMesh::cross(nb, b[(i + 1) % 3] - b[i]));
-  }
-  for (Vec3 axis : axes) {
-    const double n = axis.norm();
-    if (n < 1e-300) continue;
-    axis /= n;
-    double a0 = 1e300, a1 = -1e300, b0 = 1e300, b1 = -1e300;
-    for (const Vec3& p : a) a0 = std::min(a0, OpenMesh::dot(p, axis)), a1 = std::max(a1, OpenMesh::dot(p, axis));
-    for (const Vec3& p : b) b0 = std::min(b0, OpenMesh::dot(p, axis)), b1 = std::max(b1, OpenMesh::dot(p, axis));
-    if (a1 < b0 + tolerance || b1 < a0 + tolerance) return false;
-  }
-  return true;
-}
-
-/// Pairs of faces that intersect and share no vertex (a uniform grid of face bounding boxes).
-std::size_t self_intersections(const SurfaceMesh& mesh) {
-  const BoundingBox box = bounding_box(mesh);
-  const double cell = std::max(edge_length_stats(mesh).mean * 2, 1e-12), tolerance = 1e-9 * box.diagonal();
-  std::vector<Triangle> tri;
-  std::vector<std::array<int, 3>> ids;
-  for (auto f : mesh.faces()) {
-    Triangle t;
-    std::array<int, 3> id;
-    int k = 0;
-    for (auto v : mesh.fv_range(f)) t[k] = mesh.point(v), id[k++] = v.idx();
-    tri.push_back(t);
-    ids.push_back(id);
-  }
-  auto key = [&](int x, int y, int z) { return (std::int64_t(x) * 73856093) ^ (std::int64_t(y) * 19349663) ^ (std::int64_t(z) * 83492791); };
-  std::unordered_map<std::int64_t, std::vector<int>> grid;
-  auto range = [&](const Triangle& t, int axis) {
-    double lo = std::min({t[0][axis], t[1][axis], t[2][axis]}), hi = std::max({t[0][axis], t[1][axis], t[2][axis]});
-    return std::pair<int, int>(int(std::floor((lo - box.min[axis]) / cell)), int(std::floor((hi - box.min[axis]) / cell)));
-  };
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < tri.size(); ++i) {
-    const auto [x0, x1] = range(tri[i], 0);
-    const auto [y0, y1] = range(tri[i], 1);
-    const auto [z0, z1] = range(tri[i], 2);
-    std::vector<int> candidates;
-    for (int x = x0; x <= x1; ++x)
-      for (int y = y0; y <= y1; ++y)
-        for (int z = z0; z <= z1; ++z) {
-          auto& bucket = grid[key(x, y, z)];
-          candidates.insert(candidates.end(), bucket.begin(), bucket.end());
-          bucket.push_back(int(i));
-        }
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-    for (int j : candidates) {
-      bool shared = false;
-      for (int a : ids[i])
-        for (int b : ids[std::size_t(j)]) shared |= a == b;
-      if (!shared && triangles_intersect(tri[i], tri[std::size_t(j)], tolerance)) ++count;
-    }
-  }
-  return count;
 }
 
 }  // namespace
@@ -178,7 +108,7 @@ int main(int argc, char** argv) {
     const double in_to_out = distance_to(input, out_surface, false) / hausd;
     const double area_change = 100 * (total_area(output) / total_area(input) - 1);
     const double sharp_in = sharp_length(input), sharp_out = sharp_length(output);
-    const std::size_t x_in = self_intersections(input), x_out = self_intersections(output);
+    const std::size_t x_in = self_intersections(input).size(), x_out = self_intersections(output).size();
     const auto q_in = quality_stats(input), q = quality_stats(output);
     std::printf("%-22s %8zu %8zu %6.3f %6.3f %6.3f %9.2f %9.2f %8.3f %10.4g %10.4g %6zu %6zu %8.0f\n", name.c_str(),
                 input.n_faces(), output.n_faces(), q_in.min, q.min, q.mean, out_to_in, in_to_out, area_change, sharp_in,

@@ -10,6 +10,7 @@
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/projection.hpp>
 #include <bodyfit/remesh.hpp>
+#include <bodyfit/self_intersections.hpp>
 #include <bodyfit/validate.hpp>
 
 #include <cmath>
@@ -925,4 +926,31 @@ TEST_CASE("ReferenceSurface::max_curvature: 1/R on a fine sphere, 0 on a plane, 
   const ReferenceSurface cube(make_cube(4));  // 90° creases between triangles 0.5 / 3 · √5 apart at most
   CHECK(cube.max_curvature() > 3);
   CHECK(ReferenceSurface::sphere(Vec3(0, 0, 0), 4)->max_curvature() == 0.25);
+}
+
+TEST_CASE("self-intersections of a creased part are looked for, and those no operation separates are reported") {
+  // Two cubes crossing each other, as one surface: the remesh cannot separate them (they are the
+  // input's), and says so; one cube alone has none.
+  SurfaceMesh one = make_cube(6);
+  RemeshOptions options;
+  options.hmax = 2.0 / 4;
+  SurfaceMesh alone = one;
+  CHECK(remesh(alone, options).self_intersections == 0);
+  SurfaceMesh two = one;
+  std::vector<VertexHandle> copy;
+  for (auto v : one.vertices()) copy.push_back(two.add_vertex(one.point(v) + Vec3(1.0, 0.5, 0.3)));
+  for (auto f : one.faces()) {
+    std::vector<VertexHandle> corners;
+    for (auto v : one.fv_range(f)) corners.push_back(copy[std::size_t(v.idx())]);
+    two.region(two.add_face(corners)) = kOutside;
+  }
+  REQUIRE(self_intersections(two).size() > 0);
+  SurfaceMesh unchecked = two;
+  const auto report = remesh(two, options);
+  CHECK(report.self_intersections > 0);
+  CHECK(report.self_intersections == self_intersections(two).size());
+  // Not looked for without the distance checks (nor on an analytic or smooth reference).
+  options.check_distance_to_reference = false;
+  CHECK(remesh(unchecked, options).self_intersections == 0);
+  CHECK(self_intersections(unchecked).size() > 0);
 }

@@ -353,6 +353,7 @@ RemeshReport Remesher::run() {
   final_sweep();
   stamp("sweep");
   if (!slivers_.empty() && repair_slivers() > 0) final_sweep();
+  if (check_distance_) repair_self_intersections();
   stamp("repair");
   release();
   // A full renumbering costs a sort and a pass over every array (~0.1 s at a million faces); an

@@ -1,6 +1,8 @@
 // Remesher: the sliver repair after the passes, and the report of degenerate triangles.
 #include "remesher.hpp"
 
+#include <bodyfit/self_intersections.hpp>
+
 namespace bodyfit::remesh_detail {
 
 // Whether the cap (a, b, c) of the halfedge h = a→b, whose apex c lies on its own feature edge ab,
@@ -166,6 +168,33 @@ bool Remesher::repair(FaceHandle f) {
     case Op::None: return false;
   }
   return false;
+}
+
+// Triangles on the two sides of a sharp crease of a triangle reference may cross where a vertex
+// sits next to the crease (no check of the passes looks beyond a triangle's neighbours), and an
+// input may cross itself. Each crossing pair gets the sliver repair's best operation on either
+// triangle, for a few rounds; the pairs left are reported (RemeshReport::self_intersections), never
+// silently returned.
+void Remesher::repair_self_intersections() {
+  std::vector<std::pair<int, int>> pairs = self_intersections(m_);
+  for (int round = 0; round < kRepairRounds && !pairs.empty(); ++round) {
+    std::size_t repaired = 0;
+    for (auto [f, g] : pairs)
+      for (int face : {f, g})
+        if (!m_.status(FaceHandle(face)).deleted() && repair(FaceHandle(face))) ++repaired;
+    if (repaired == 0) break;
+    final_sweep();
+    pairs = self_intersections(m_);
+
+  }
+  report_.self_intersections = pairs.size();
+  if (!pairs.empty()) {
+    const auto p = points(FaceHandle(pairs.front().first));
+    const Vec3 at = (p[0] + p[1] + p[2]) / 3.0;
+    spdlog::warn("remesh: {} pair(s) of triangles intersect (faces {} and {}, near ({:.6g}, {:.6g}, {:.6g})); no local "
+                 "operation could separate them",
+                 pairs.size(), pairs.front().first, pairs.front().second, at[0], at[1], at[2]);
+  }
 }
 
 // Every operation refuses degenerate triangles and the repair removes those of its input it can: a

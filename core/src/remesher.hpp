@@ -252,6 +252,7 @@ class Remesher {
   double chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) const;
   bool chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old, const Vec3& b_old) const;
   std::size_t repair_slivers();
+  void repair_self_intersections();
   std::vector<std::pair<double, FaceHandle>> slivers_;  // faces below kRepairBelow (final_sweep)
   bool repair(FaceHandle f);
   void report_degenerate() const;

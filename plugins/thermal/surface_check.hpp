@@ -4,6 +4,7 @@
 // no deleted elements, every vertex used, no degenerate or duplicate vertex, closed, manifold,
 // outward orientation (positive enclosed volume), no self-intersection.
 #include <bodyfit/mesh.hpp>
+#include <bodyfit/self_intersections.hpp>
 
 #include <utility>
 #include <vector>
@@ -18,11 +19,6 @@ struct SurfaceCheckOptions {
 /// (12 boundary edges): the thermal model needs the skin of a solid". `what` prefixes the message.
 void check_solid_surface(const SurfaceMesh& surface, const SurfaceCheckOptions& options = {},
                          const char* what = "thermal model");
-
-/// Pairs of faces (by index, first < second) that intersect other than along the edge or vertex
-/// they share; at most `limit` pairs. Coordinates are compared with a tolerance of 1e-10 of the
-/// bounding-box diagonal, so faces closer than that count as touching.
-std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, std::size_t limit = 1);
 
 /// Volume enclosed by a closed surface (divergence theorem): positive for an outward orientation.
 double enclosed_volume(const SurfaceMesh& surface);
