@@ -116,6 +116,8 @@ int main(int argc, char** argv) {
   args.parse(argc, argv);
   if (!(h > 0)) args.fail("--h: a positive mesh size");
   if (iterations < 2) args.fail("--iterations: at least 2 (the first is not counted)");
+  if (threads < 0) args.fail("--threads: a positive count (0: every core)");
+  if (!std::filesystem::exists(case_path)) args.fail(case_path + ": no such case (run from the source tree, or give --case)");
   std::unique_ptr<tbb::global_control> control;
   if (threads > 0) control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   spdlog::set_level(spdlog::level::warn);
@@ -124,7 +126,6 @@ int main(int argc, char** argv) {
   std::printf("bandwidth: read %.1f GB/s, copy %.1f GB/s (read + written)\n", bandwidth.read, bandwidth.copy);
 
   // The shipped case at the benchmark suite's settings: h = hmax, hmin = h/10, outputs off.
-  if (!std::filesystem::exists(case_path)) args.fail(case_path + ": no such case (run from the source tree, or give --case)");
   toml::table table = toml::parse_file(case_path);
   table["surface"].as_table()->insert_or_assign("h", h);
   table["remesh"].as_table()->insert_or_assign("hmax", h);
