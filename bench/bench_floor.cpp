@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
 
   auto median = [&](double StageTimes::*stage) {
     std::vector<double> ms;
-    for (std::size_t k = 2; k < result.records.size(); ++k) ms.push_back(result.records[k].ms.*stage);
+    for (std::size_t k = 1; k < result.records.size(); ++k) ms.push_back(result.records[k].ms.*stage);  // not the first
     std::sort(ms.begin(), ms.end());
     return ms.empty() ? 0.0 : ms[ms.size() / 2];
   };
