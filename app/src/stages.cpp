@@ -3,6 +3,7 @@
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
+#include <bodyfit/projection.hpp>
 
 #include <fmt/format.h>
 
@@ -72,6 +73,9 @@ DiscretizeStageReport discretize_stage(SurfaceMesh& mesh, const ScalarField& phi
   if (remesh_after) check_face_budget(estimate_remesh_faces(mesh, options), "discretize: edges of at most hmax");
   // The default size is the input's resolution, measured before the cut adds its small edges.
   if (options.hmax <= 0) options.hmax = resolution_length(mesh);
+  // S is the input: the cut puts points on its triangles, it makes no new surface (and the slivers
+  // it leaves would make the remesh's curvature bound, ReferenceSurface::max_curvature, meaningless).
+  if (remesh_after && !options.reference) options.reference = std::make_shared<const ReferenceSurface>(mesh);
   DiscretizeStageReport report;
   auto start = std::chrono::steady_clock::now();
   report.cut = discretize(mesh, phi, cut);
