@@ -17,6 +17,7 @@ namespace bodyfit {
 namespace remesh_detail {
 
 void Remesher::mark(VertexHandle v) {
+  touch(v);
   if (!m_.property(in_next_, v)) {
     m_.property(in_next_, v) = 1;
     next_.push_back(v);

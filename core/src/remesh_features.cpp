@@ -136,6 +136,7 @@ void Remesher::classify_features() {
             auto sp = ref_->closest(m_.point(v), m_.property(hint_, v));
             Change change;
             if (!move_check(v, sp.point, sp.normal, change)) continue;
+            touch(v);
             m_.set_point(v, sp.point);
             m_.property(hint_, v) = sp.face;
           }

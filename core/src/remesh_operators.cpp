@@ -56,6 +56,7 @@ bool Remesher::split(EdgeHandle e) {
   m_.property(vnormal_, v) = sp.normal;
   m_.property(in_work_, v) = 0;
   m_.property(in_next_, v) = 0;
+  m_.property(touched_, v) = 0;
   m_.phi(v) = phi;
   m_.vertex_ref(v) = 0;
   m_.corner(v) = 0;
@@ -486,6 +487,7 @@ bool Remesher::move_lengthens(VertexHandle v, const Vec3& q) const {
 }
 
 void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
+  touch(v);
   m_.set_point(v, q);
   m_.property(hint_, v) = sp.face;
   m_.property(vnormal_, v) = sp.normal;

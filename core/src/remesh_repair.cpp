@@ -172,11 +172,23 @@ bool Remesher::repair(FaceHandle f) {
 
 // Triangles on the two sides of a sharp crease of a triangle reference may cross where a vertex
 // sits next to the crease (no check of the passes looks beyond a triangle's neighbours), and an
-// input may cross itself. Each crossing pair gets the sliver repair's best operation on either
+// input may cross itself. Each crossing pair near a vertex this remesh queued or moved gets the sliver repair's best operation on either
 // triangle, for a few rounds; the pairs left are reported (RemeshReport::self_intersections), never
 // silently returned.
 void Remesher::repair_self_intersections() {
-  std::vector<std::pair<int, int>> pairs = self_intersections(m_);
+  // Only near what this remesh changed: a sweep of the whole surface's grid would cost more than an
+  // evolution step's whole remesh (175 ms on a 240k-face height field against 50).
+  std::vector<int> changed;
+  auto near_changes = [&] {
+    changed.clear();
+    for (auto v : touched_list_)
+      if (!m_.status(v).deleted())
+        for (auto f : m_.vf_range(v)) changed.push_back(f.idx());
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    return self_intersections_near(m_, changed);
+  };
+  std::vector<std::pair<int, int>> pairs = near_changes();
   for (int round = 0; round < kRepairRounds && !pairs.empty(); ++round) {
     std::size_t repaired = 0;
     for (auto [f, g] : pairs)
@@ -184,7 +196,7 @@ void Remesher::repair_self_intersections() {
         if (!m_.status(FaceHandle(face)).deleted() && repair(FaceHandle(face))) ++repaired;
     if (repaired == 0) break;
     final_sweep();
-    pairs = self_intersections(m_);
+    pairs = near_changes();
 
   }
   report_.self_intersections = pairs.size();

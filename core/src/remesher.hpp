@@ -160,6 +160,7 @@ class Remesher {
     m_.add_property(in_work_);
     m_.add_property(in_next_);
     m_.add_property(depth_);
+    m_.add_property(touched_);
     m_.add_property(ecurve_);
   }
   ~Remesher() { release(); }
@@ -175,6 +176,7 @@ class Remesher {
     m_.remove_property(in_work_);
     m_.remove_property(in_next_);
     m_.remove_property(depth_);
+    m_.remove_property(touched_);
     m_.remove_property(ecurve_);
   }
   Remesher(const Remesher&) = delete;
@@ -285,6 +287,14 @@ class Remesher {
   OpenMesh::VPropHandleT<int> hint_;
   OpenMesh::VPropHandleT<Vec3> vnormal_;
   OpenMesh::VPropHandleT<char> in_work_, in_next_;
+  OpenMesh::VPropHandleT<char> touched_;  // queued or moved by this remesh (touched_list_)
+  std::vector<VertexHandle> touched_list_;
+  void touch(VertexHandle v) {
+    if (!m_.property(touched_, v)) {
+      m_.property(touched_, v) = 1;
+      touched_list_.push_back(v);
+    }
+  }
   // Rings of smoothing since the last split/collapse/flip or bad element: bounds how far
   // relocation spreads into the already-good mesh.
   OpenMesh::VPropHandleT<char> depth_;

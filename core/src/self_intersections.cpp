@@ -150,7 +150,12 @@ std::uint64_t cell_key(std::int64_t i, std::int64_t j, std::int64_t k) {
 
 }  // namespace
 
-std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, std::size_t limit) {
+namespace {
+
+/// The crossing pairs, all of them (near == nullptr) or those with a face flagged in `near` (by face
+/// index): the other faces then enter only the grid cells the flagged ones occupy.
+std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, const std::vector<char>* near,
+                                                std::size_t limit) {
   std::vector<std::pair<int, int>> found;
   if (surface.n_faces() < 2 || limit == 0) return found;
   auto box = bounding_box(surface);
@@ -159,6 +164,7 @@ std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, 
 
   std::vector<Triangle> tris;
   std::vector<int> face_of;  // the face index of each triangle (deleted faces are skipped)
+  std::vector<char> flagged;  // the triangle's face is one of `near`
   tris.reserve(surface.n_faces());
   double edge_sum = 0;
   for (auto f : surface.faces()) {
@@ -175,6 +181,7 @@ std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, 
     edge_sum += (t.p[1] - t.p[0]).norm() + (t.p[2] - t.p[1]).norm() + (t.p[0] - t.p[2]).norm();
     tris.push_back(t);
     face_of.push_back(f.idx());
+    flagged.push_back(!near || (std::size_t(f.idx()) < near->size() && (*near)[std::size_t(f.idx())]));
   }
   // A uniform grid of cells about twice the mean edge: a few triangles per cell on a well-spread
   // mesh. Each pair is tested once, in the cell holding the lower corner of their boxes' overlap.
@@ -182,16 +189,25 @@ std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, 
   auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
   grid.reserve(tris.size() * 2);
-  for (int f = 0; f < int(tris.size()); ++f) {
-    const auto& t = tris[std::size_t(f)];
-    for (auto i = index(t.lo[0], box.min[0]); i <= index(t.hi[0], box.min[0]); ++i)
-      for (auto j = index(t.lo[1], box.min[1]); j <= index(t.hi[1], box.min[1]); ++j)
-        for (auto k = index(t.lo[2], box.min[2]); k <= index(t.hi[2], box.min[2]); ++k)
-          grid[cell_key(i, j, k)].push_back(f);
-  }
+  // The flagged triangles first; then the others, into the cells the flagged ones occupy only.
+  for (int pass = 0; pass < 2; ++pass)
+    for (int f = 0; f < int(tris.size()); ++f) {
+      if (bool(flagged[std::size_t(f)]) != (pass == 0)) continue;
+      const auto& t = tris[std::size_t(f)];
+      for (auto i = index(t.lo[0], box.min[0]); i <= index(t.hi[0], box.min[0]); ++i)
+        for (auto j = index(t.lo[1], box.min[1]); j <= index(t.hi[1], box.min[1]); ++j)
+          for (auto k = index(t.lo[2], box.min[2]); k <= index(t.hi[2], box.min[2]); ++k) {
+            if (pass == 0) {
+              grid[cell_key(i, j, k)].push_back(f);
+            } else if (auto it = grid.find(cell_key(i, j, k)); it != grid.end()) {
+              it->second.push_back(f);
+            }
+          }
+    }
   for (const auto& [key, members] : grid) {
     for (std::size_t m = 0; m < members.size(); ++m)
       for (std::size_t n = m + 1; n < members.size(); ++n) {
+        if (!flagged[std::size_t(members[m])] && !flagged[std::size_t(members[n])]) continue;
         const auto& a = tris[std::size_t(members[m])];
         const auto& b = tris[std::size_t(members[n])];
         Vec3 lo = a.lo, hi = a.hi;
@@ -211,6 +227,20 @@ std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, 
   }
   std::sort(found.begin(), found.end());
   return found;
+}
+
+}  // namespace
+
+std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface, std::size_t limit) {
+  return find_crossings(surface, nullptr, limit);
+}
+
+std::vector<std::pair<int, int>> self_intersections_near(const SurfaceMesh& surface, std::span<const int> faces,
+                                                         std::size_t limit) {
+  std::vector<char> near(surface.n_faces(), 0);
+  for (int f : faces)
+    if (f >= 0 && std::size_t(f) < near.size()) near[std::size_t(f)] = 1;
+  return find_crossings(surface, &near, limit);
 }
 
 }  // namespace bodyfit

@@ -76,10 +76,11 @@ struct RemeshReport {
   std::size_t long_edges = 0;
   double max_edge_ratio = 0;  ///< longest edge / its target size
   double min_quality = 0, mean_quality = 0;
-  /// Pairs of triangles that intersect at the end, looked for when the changes are held within hausd
-  /// of a triangle reference (RemeshOptions::check_distance_to_reference: a CAD part, a scan), where
-  /// triangles on the two sides of a sharp crease may cross; those found get the sliver repair's
-  /// operations, and the ones left are counted here and warned about. 0 when not looked for.
+  /// Pairs of triangles that intersect at the end near what the remesh changed (a face around a
+  /// vertex it queued or moved), looked for when the changes are held within hausd of a triangle
+  /// reference (RemeshOptions::check_distance_to_reference: a CAD part, a scan), where triangles on
+  /// the two sides of a sharp crease may cross; those found get the sliver repair's operations, and
+  /// the ones left are counted here and warned about. 0 when not looked for.
   std::size_t self_intersections = 0;
   double milliseconds = 0;
 };

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <limits>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -16,5 +17,10 @@ namespace bodyfit {
 /// onto each other. Tolerance 1e-10 of the bounding box's diagonal.
 std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface,
                                                     std::size_t limit = std::numeric_limits<std::size_t>::max());
+
+/// The same, among the pairs with at least one of `faces` (face indices): the crossings near a
+/// change, at the cost of those faces' neighbourhoods rather than the whole surface's grid.
+std::vector<std::pair<int, int>> self_intersections_near(const SurfaceMesh& surface, std::span<const int> faces,
+                                                         std::size_t limit = std::numeric_limits<std::size_t>::max());
 
 }  // namespace bodyfit
