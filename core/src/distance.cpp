@@ -207,7 +207,7 @@ class FastMarch {
         // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's
         // when it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
         track_(options.front_curvature && !seeds.bends.empty()),
-        gauss_(track_ ? gaussian_curvature(m) : std::vector<double>()) {}
+        gauss_(track_ ? m.nv : 0, kUnknown) {}
 
   /// Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
   /// segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
@@ -285,7 +285,7 @@ class FastMarch {
     if (track_) {
       const auto& [a, b] = seeds_.segments[best_segment];
       const auto& [ka, kb] = seeds_.bends[best_segment];
-      kappa_[x] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss_[x]);
+      kappa_[x] = a == b ? 0.0 : carried_curvature(curvature_seen_from(p, a, b, ka, kb), best, gauss(x));
     }
   }
 
@@ -311,13 +311,13 @@ class FastMarch {
   }
 
   /// The update of x from the triangle (x; a, b).
-  FrontValue update(const CornerGeometry& g, int a, int b, int x) const {
+  FrontValue update(const CornerGeometry& g, int a, int b, int x) {
     if (!track_) return FrontValue{triangle_update(g, dist_[a], dist_[b])};
-    return front_update(g, dist_[a], dist_[b], kappa_[a], kappa_[b], (gauss_[a] + gauss_[b] + gauss_[x]) / 3);
+    return front_update(g, dist_[a], dist_[b], kappa_[a], kappa_[b], (gauss(a) + gauss(b) + gauss(x)) / 3);
   }
 
   /// The update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
-  FrontValue split_update(int split) const {
+  FrontValue split_update(int split) {
     const ObtuseSplit& s = m_.splits[split];
     FrontValue value;
     if (!known(s.vertex)) return value;
@@ -364,7 +364,7 @@ class FastMarch {
         }
         if (value.d == kInf) {
           const double length = ev.norm();
-          value = {d + length, track_ ? carried_curvature(kappa_[v], length, gauss_[x]) : 0.0};
+          value = {d + length, track_ ? carried_curvature(kappa_[v], length, gauss(x)) : 0.0};
         }
         lower(x, value, heap);
       }
@@ -386,7 +386,15 @@ class FastMarch {
   std::vector<double>& kappa_;
   std::vector<std::uint8_t>& state_;
   const bool track_;
-  const std::vector<double> gauss_;
+  /// The Gaussian curvature at v, computed when the march first needs it: a band touches a small
+  /// part of a large mesh.
+  double gauss(int v) {
+    double& value = gauss_[v];
+    if (std::isnan(value)) value = gaussian_curvature(m_, v);
+    return value;
+  }
+  static constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> gauss_;
 };
 
 /// Exact initialisation next to the seeds, then fast marching up to options.narrow_band. The result

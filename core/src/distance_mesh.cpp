@@ -8,6 +8,9 @@
 #include <cmath>
 #include <numbers>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace bodyfit::distance_detail {
 namespace {
 
@@ -20,20 +23,23 @@ FlatMesh flatten(const SurfaceMesh& mesh) {
   m.corner_vertex.resize(3 * m.nf);
   m.across.resize(3 * m.nf);
   m.obtuse.assign(3 * m.nf, -1);
-  for (std::size_t f = 0; f < m.nf; ++f) {
+  for (std::size_t f = 0; f < m.nf; ++f)
     if (mesh.status(FaceHandle(int(f))).deleted())
       throw InputError("signed_distance: the mesh must be garbage-collected");
-    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
-    const auto h1 = mesh.next_halfedge_handle(h0);
-    const auto h2 = mesh.next_halfedge_handle(h1);
-    m.corner_vertex[3 * f + 0] = mesh.from_vertex_handle(h0).idx();
-    m.corner_vertex[3 * f + 1] = mesh.to_vertex_handle(h0).idx();
-    m.corner_vertex[3 * f + 2] = mesh.to_vertex_handle(h1).idx();
-    // corner c is opposite the halfedge from corner c+1 to corner c+2
-    m.across[3 * f + 0] = mesh.opposite_face_handle(h1).idx();
-    m.across[3 * f + 1] = mesh.opposite_face_handle(h2).idx();
-    m.across[3 * f + 2] = mesh.opposite_face_handle(h0).idx();
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m.nf, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t f = range.begin(); f != range.end(); ++f) {
+      const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
+      const auto h1 = mesh.next_halfedge_handle(h0);
+      const auto h2 = mesh.next_halfedge_handle(h1);
+      m.corner_vertex[3 * f + 0] = mesh.from_vertex_handle(h0).idx();
+      m.corner_vertex[3 * f + 1] = mesh.to_vertex_handle(h0).idx();
+      m.corner_vertex[3 * f + 2] = mesh.to_vertex_handle(h1).idx();
+      // corner c is opposite the halfedge from corner c+1 to corner c+2
+      m.across[3 * f + 0] = mesh.opposite_face_handle(h1).idx();
+      m.across[3 * f + 1] = mesh.opposite_face_handle(h2).idx();
+      m.across[3 * f + 2] = mesh.opposite_face_handle(h0).idx();
+    }
+  });
   return m;
 }
 
@@ -137,16 +143,18 @@ void split_obtuse_corner(FlatMesh& m, int k) {
 }
 
 void find_obtuse_corners(FlatMesh& m) {
-  for (std::size_t k = 0; k < 3 * m.nf; ++k) {
-    const int f = int(k / 3), c = int(k % 3);
-    const Vec3& x = m.points[m.corner_vertex[3 * f + c]];
-    const Vec3& a = m.points[m.corner_vertex[3 * f + (c + 1) % 3]];
-    const Vec3& b = m.points[m.corner_vertex[3 * f + (c + 2) % 3]];
-    if (((a - x) | (b - x)) < 0) {
-      m.obtuse[k] = -2;  // obtuse, no split found (yet)
-      split_obtuse_corner(m, int(k));
+  // Found in parallel (obtuse, no split found yet: −2), split in corner order (the splits' indices).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, 3 * m.nf, 3 * 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t k = range.begin(); k != range.end(); ++k) {
+      const int f = int(k / 3), c = int(k % 3);
+      const Vec3& x = m.points[m.corner_vertex[3 * f + c]];
+      const Vec3& a = m.points[m.corner_vertex[3 * f + (c + 1) % 3]];
+      const Vec3& b = m.points[m.corner_vertex[3 * f + (c + 2) % 3]];
+      if (((a - x) | (b - x)) < 0) m.obtuse[k] = -2;
     }
-  }
+  });
+  for (std::size_t k = 0; k < 3 * m.nf; ++k)
+    if (m.obtuse[k] == -2) split_obtuse_corner(m, int(k));
 }
 
 }  // namespace
@@ -160,25 +168,18 @@ FlatMesh prepared_mesh(const SurfaceMesh& mesh) {
 
 /// Discrete Gaussian curvature at each vertex: angle defect over a third of the incident area
 /// (0 on the boundary, where the defect measures the boundary's turning instead).
-std::vector<double> gaussian_curvature(const FlatMesh& m) {
-  std::vector<double> angle(m.nv, 0.0), area(m.nv, 0.0);
-  std::vector<char> boundary(m.nv, 0);
-  for (std::size_t f = 0; f < m.nf; ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int v = m.corner_vertex[3 * f + c];
-      const Vec3& p = m.points[v];
-      const Vec3 u = m.points[m.corner_vertex[3 * f + (c + 1) % 3]] - p, w = m.points[m.corner_vertex[3 * f + (c + 2) % 3]] - p;
-      angle[v] += std::atan2((u % w).norm(), u | w);
-      area[v] += (u % w).norm() / 6;
-      if (m.across[3 * f + c] < 0) {  // the edge opposite c is a boundary edge: both its ends are
-        boundary[m.corner_vertex[3 * f + (c + 1) % 3]] = 1;
-        boundary[m.corner_vertex[3 * f + (c + 2) % 3]] = 1;
-      }
-    }
-  std::vector<double> gauss(m.nv, 0.0);
-  for (std::size_t v = 0; v < m.nv; ++v)
-    if (!boundary[v] && area[v] > 0) gauss[v] = (2 * std::numbers::pi - angle[v]) / area[v];
-  return gauss;
+double gaussian_curvature(const FlatMesh& m, int v) {
+  double angle = 0, area = 0;
+  const Vec3& p = m.points[v];
+  for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j) {  // the faces around v, in index order
+    const int f = m.fan[j].corner / 3, c = m.fan[j].corner % 3;
+    const Vec3 u = m.points[m.corner_vertex[3 * f + (c + 1) % 3]] - p, w = m.points[m.corner_vertex[3 * f + (c + 2) % 3]] - p;
+    angle += std::atan2((u % w).norm(), u | w);
+    area += (u % w).norm() / 6;
+    // An edge of v without a face across: v is on the boundary.
+    if (m.across[3 * f + (c + 1) % 3] < 0 || m.across[3 * f + (c + 2) % 3] < 0) return 0;
+  }
+  return area > 0 ? (2 * std::numbers::pi - angle) / area : 0.0;
 }
 
 }  // namespace bodyfit::distance_detail

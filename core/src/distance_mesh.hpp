@@ -50,8 +50,8 @@ struct FlatMesh {
 /// The flat arrays of `mesh`, its obtuse corners split and its fans built.
 FlatMesh prepared_mesh(const SurfaceMesh& mesh);
 
-/// Discrete Gaussian curvature at each vertex: angle defect over a third of the incident area
+/// Discrete Gaussian curvature at vertex v: angle defect over a third of the incident area
 /// (0 on the boundary, where the defect measures the boundary's turning instead).
-std::vector<double> gaussian_curvature(const FlatMesh& m);
+double gaussian_curvature(const FlatMesh& m, int v);
 
 }  // namespace bodyfit::distance_detail

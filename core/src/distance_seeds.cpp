@@ -119,8 +119,15 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved)
       s.zeros.push_back(int(v));
     }
   s.seg_start.push_back(0);
-  for (std::size_t f = 0; f < m.nf; ++f) {
-    const auto h0 = mesh.halfedge_handle(FaceHandle(int(f)));
+  // A seed face has an interface edge or a corner on the interface: one of the faces around the
+  // interface's vertices (in index order, as a pass over every face would find them).
+  std::vector<int> around;
+  for (int v : s.zeros)
+    for (auto f : mesh.vf_range(VertexHandle(v))) around.push_back(f.idx());
+  std::sort(around.begin(), around.end());
+  around.erase(std::unique(around.begin(), around.end()), around.end());
+  for (int f : around) {
+    const auto h0 = mesh.halfedge_handle(FaceHandle(f));
     bool seed = false;
     for (auto h : {h0, mesh.next_halfedge_handle(h0), mesh.prev_halfedge_handle(h0)}) {
       const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
@@ -133,7 +140,7 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved)
       }
     }
     if (!seed) continue;
-    s.faces.push_back(int(f));
+    s.faces.push_back(f);
     s.seg_start.push_back(int(s.segments.size()));
   }
   return s;
