@@ -3,7 +3,8 @@
 // machine measures, beside the stage's time on the conormal case (docs/validation/performance.md,
 // "The physical floor").
 //
-//   bench_floor [--case meshes/cases/sphere_cap.toml] [--h 0.0054] [--iterations 4] [--threads N] [-o floor.csv]
+//   bench_floor [--case meshes/cases/sphere_cap.toml] [--h 0.0054] [--iterations 4] [--threads N]
+//               [--whole-surface] [-o floor.csv]
 //
 // The floor of a stage is what streaming its data once would cost: a stage at 10× its floor spends
 // 90 % of its time on something else than moving the data it needs (latency of irregular accesses,
@@ -99,20 +100,23 @@ std::vector<StageData> stage_data(double nv, double nf) {
 int main(int argc, char** argv) {
   double h = 0.0054;
   int iterations = 4, threads = 0;
+  bool whole_surface = false;
   std::string csv_path = "floor.csv", case_path = "meshes/cases/sphere_cap.toml";
   bench::Arguments args("bench_floor",
                         "usage: bench_floor [--case meshes/cases/sphere_cap.toml] [--h 0.0054] [--iterations 4]\n"
-                        "                   [--threads N] [-o floor.csv]\n"
+                        "                   [--threads N] [--whole-surface] [-o floor.csv]\n"
                         "  --case        the conormal case (run with h = hmax = --h, hmin = h/10, outputs off)\n"
                         "  --h           its mesh size (0.0054: about a million faces)\n"
                         "  --iterations  iterations run; the stage times are the medians after the first\n"
                         "  --threads     worker threads (default: every core)\n"
+                        "  --whole-surface  d and the advection on the whole surface ([time] narrow_band = false)\n"
                         "  -o            the CSV written (one row per stage)\n");
   args.option("--case", case_path);
   args.option("--h", h);
   args.option("--iterations", iterations);
   args.option("--threads", threads);
   args.option("-o", csv_path);
+  args.flag("--whole-surface", whole_surface);
   args.parse(argc, argv);
   if (!(h > 0)) args.fail("--h: a positive mesh size");
   if (iterations < 2) args.fail("--iterations: at least 2 (the first is not counted)");
@@ -132,6 +136,7 @@ int main(int argc, char** argv) {
   table["remesh"].as_table()->insert_or_assign("hmin", h / 10);
   table["time"].as_table()->erase("final_time");
   table["time"].as_table()->insert_or_assign("iterations", iterations);
+  if (whole_surface) table["time"].as_table()->insert_or_assign("narrow_band", false);
   table.erase("output");
   CaseConfig config = parse_case(table);
   LoadedModel model = load_model(config.model);

@@ -38,6 +38,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -100,8 +101,9 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
     // same edges in reverse (each crossing undone by the entered face's own map).
     Location y = from;
     path.clear();
-    if (walk(s, y, d, &path) == WalkEnd::stalled) return false;
-    if (!known(y.face)) {
+    const WalkEnd end = walk(s, y, d, &path);
+    if (end == WalkEnd::stalled) return false;
+    if (end == WalkEnd::left || !known(y.face)) {
       r.outside = true;
       return false;
     }
@@ -146,7 +148,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
         }
         const WalkEnd end = walk(s, x, (-dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4), nullptr);
         if (end != WalkEnd::arrived) {
-          (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
+          (end == WalkEnd::boundary ? r.boundary : end == WalkEnd::left ? r.outside : r.stalled) = true;
           break;
         }
       } else {
@@ -166,7 +168,7 @@ TraceResult trace(const Surface& s, Location start, double T, const AdvectionOpt
         }
         const WalkEnd end = walk(s, x, (-dt) * k2, nullptr);
         if (end != WalkEnd::arrived) {
-          (end == WalkEnd::boundary ? r.boundary : r.stalled) = true;
+          (end == WalkEnd::boundary ? r.boundary : end == WalkEnd::left ? r.outside : r.stalled) = true;
           break;
         }
       }
@@ -394,9 +396,11 @@ void trace_composed(const Surface& s, Composition& c, const ScalarField& phi, co
 }  // namespace
 
 struct Advector::Impl {
-  explicit Impl(const SurfaceMesh& m) : mesh(m), surface(build_surface(m)) {}
+  Impl(const SurfaceMesh& m, std::span<const int> faces)
+      : mesh(m), surface(build_surface(m, faces)), partial(!faces.empty()) {}
   const SurfaceMesh& mesh;
   Surface surface;
+  bool partial;                           ///< built on some faces only: band calls only
   std::uint32_t epoch = 0;
   VectorField gradients;                  ///< of φ, where the current call needs them
   std::vector<std::uint32_t> vertex_seen;  ///< band calls: = epoch for the vertices where V is known
@@ -410,13 +414,15 @@ struct Advector::Impl {
                                                 const ScalarField& out, const AdvectionOptions& options);
 };
 
-Advector::Advector(const SurfaceMesh& mesh) : impl_(std::make_unique<Impl>(mesh)) {}
+Advector::Advector(const SurfaceMesh& mesh) : impl_(std::make_unique<Impl>(mesh, std::span<const int>())) {}
+Advector::Advector(const SurfaceMesh& mesh, std::span<const int> faces) : impl_(std::make_unique<Impl>(mesh, faces)) {}
 Advector::~Advector() = default;
 Advector::Advector(Advector&&) noexcept = default;
 
 ScalarField Advector::advect(const ScalarField& phi, const VectorField& velocity, double T,
                              const AdvectionOptions& options, AdvectionReport* report) {
   Impl& a = *impl_;
+  if (a.partial) throw std::logic_error("Advector::advect: built on part of the mesh, it advects bands only");
   check_inputs(a.mesh, phi.size(), velocity.size(), T, options, "the velocity");
   Surface& s = a.surface;
   const double vmax = largest_speed(velocity, {});

@@ -47,10 +47,15 @@ std::size_t count_inside(const SurfaceMesh& mesh) {
 }
 
 /// d of a state: the signed distance to G, or ∓∞ everywhere when G is the whole surface or empty.
+/// Within options.narrow_band of Σ when finite, ±that width beyond (what a model can differentiate).
 ScalarField distance_of(const SurfaceMesh& mesh, DistanceSolver& solver, const DistanceOptions& options) {
   const std::size_t inside = count_inside(mesh);
-  if (inside > 0 && inside < mesh.n_faces()) return solver.signed_distance_to_region(options);
-  return ScalarField(mesh.n_vertices(), inside ? -INFINITY : INFINITY);
+  if (!(inside > 0 && inside < mesh.n_faces())) return ScalarField(mesh.n_vertices(), inside ? -INFINITY : INFINITY);
+  ScalarField d = solver.signed_distance_to_region(options);
+  if (std::isfinite(options.narrow_band))
+    for (double& value : d)
+      if (std::isinf(value)) value = std::copysign(options.narrow_band, value);
+  return d;
 }
 
 /// The model's field as the vector field V the advection takes (V = v·n_Σ for a normal speed),
@@ -94,6 +99,17 @@ std::vector<int> within(const ScalarField& phi, double width) {
   return band;
 }
 
+/// The faces with a corner among `vertices`, each once, in index order.
+std::vector<int> faces_around(const SurfaceMesh& mesh, std::span<const int> vertices) {
+  std::vector<char> seen(mesh.n_faces(), 0);
+  std::vector<int> faces;
+  for (int v : vertices)
+    for (auto f : mesh.vf_range(VertexHandle(v)))
+      if (!seen[f.idx()]) seen[f.idx()] = 1, faces.push_back(f.idx());
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
 /// What step 2 (d, V, advection, sub-steps) hands to the cut.
 struct LevelSetStep {
   ScalarField phi_next;           ///< φ^{n+1} on T^n
@@ -121,6 +137,9 @@ class Evolution {
   Evolution(SurfaceMesh& mesh, VelocityModel& model, const EvolutionOptions& options, const RunState& start,
             const EvolutionHooks& hooks)
       : mesh_(mesh), model_(model), options_(options), hooks_(hooks), needs_(model.needs()),
+        // A frozen V over CFL sub-steps transports φ on the whole surface (the whole-surface path).
+        banded_(options.narrow_band && !needs_.whole_surface_distance &&
+                !(needs_.freeze_velocity && options.max_cfl > 0)),
         n_(start.iteration), t_(start.time), dt_(start.dt > 0 ? start.dt : options.dt) {}
 
   EvolutionResult run() {
@@ -161,7 +180,7 @@ class Evolution {
     // T^n and d^n are kept only for a model that may reject (a copy of the mesh).
     std::optional<SurfaceMesh> kept_mesh;
     ScalarField kept_distance;
-    if (needs_.may_reject) kept_mesh = mesh_, kept_distance = distance_;
+    if (needs_.may_reject) kept_mesh = mesh_, kept_distance = distance_, kept_width_ = distance_width_;
     for (int attempt = 0;; ++attempt) {
       const double dt = step / std::ldexp(1.0, attempt);
       LevelSetStep level_set = level_set_step(dt, attempt);  // 2.
@@ -179,6 +198,7 @@ class Evolution {
       mesh_ = *kept_mesh;  // restore T^n exactly
       candidate_ = false;
       distance_ = kept_distance;
+      distance_width_ = kept_width_;
       solver_.reset();  // built on the candidate
       if (hooks_.log)
         spdlog::info("n={} step of dt={:.5g} rejected by model '{}': {}{}", n_ + 1, dt, model_.name(), review.reason,
@@ -205,7 +225,12 @@ class Evolution {
     // One advection over the step (or, for a frozen V, CFL sub-steps transporting φ with it).
     LevelSetStep step;
     Stopwatch clock;
-    VectorField velocity = first_velocity(step, dt, attempt, clock);
+    VectorField velocity = first_velocity(step, dt, attempt, clock, nullptr, banded_ && !(options_.max_cfl > 0));
+    if (banded_ && !(options_.max_cfl > 0)) {
+      band_step(step, velocity, dt, attempt);
+      step.ms.advect += clock.lap_ms();
+      return step;
+    }
     Advector advector(mesh_);
     ScalarField phi = distance_;
     while (step.done < dt) {
@@ -229,6 +254,11 @@ class Evolution {
     LevelSetStep step;
     Stopwatch clock;
     if (!solver_) solver_.emplace(mesh_);  // T^n's flat arrays, for every sub-step
+    if (banded_) {  // d^n must hold the sub-steps' band (front_substeps), and a ring for V there
+      const double need = front_band_width() + 2 * longest_edge_;
+      ensure_band(need);
+      band_width_ = next_band_width(need);
+    }
     Advector advector(mesh_);
     StepGeometry geometry;
     ScalarField phi = distance_;
@@ -244,7 +274,12 @@ class Evolution {
       }
       const std::span<const int> active = f.in_band ? std::span<const int>(f.band) : std::span<const int>();
       if (step.substeps == 0) {
+        const int version = distance_version_;
         velocity = first_velocity(step, dt, attempt, clock, &geometry);
+        if (version != distance_version_) {  // d^n measured again on the whole surface
+          phi = distance_;
+          f = front_substeps(phi, advector);
+        }
       } else {
         const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining, active, &geometry);
         const VelocityField field = model_.compute(context);
@@ -270,11 +305,10 @@ class Evolution {
     f.in_band = options_.narrow_band;
     f.compose = options_.compose_substeps;
     const double cap = options_.max_cfl * cfl_length();
-    const double longest = edge_length_stats(mesh_).max;
     // The front cannot reach further within a sub-step, and the cut reads φ two rings beyond the
     // vertices of its crossed edges (DiscretizeOptions::fitted_slopes): 3 edges, not 2.
-    f.traced_width = cap + 3 * longest;
-    f.width = f.traced_width + cap + 2 * longest;
+    f.traced_width = cap + 3 * longest_edge_;
+    f.width = front_band_width();
     f.band = within(phi, f.width);
     if (f.in_band) f.next = phi;
     if (f.compose) {
@@ -333,13 +367,27 @@ class Evolution {
   }
 
   /// V^n on T^n with d^n, over the whole surface (the state's outputs show it); a retried step
-  /// reuses it (T^n and d^n are those of the first attempt).
+  /// reuses it (T^n and d^n are those of the first attempt). With `check_reach` (one advection
+  /// over Δt in a band), d^n's band is widened, and V asked for again, until it holds what the
+  /// step's characteristics reach (band_need).
   VectorField first_velocity(LevelSetStep& step, double dt, int attempt, Stopwatch& clock,
-                             StepGeometry* geometry = nullptr) {
-    if (attempt == 0) {
+                             StepGeometry* geometry = nullptr, bool check_reach = false) {
+    while (attempt == 0) {
       const StepContext context = context_for(mesh_, distance_, n_, t_, dt, {}, geometry);
       state_field_ = model_.compute(context);
       state_velocity_ = velocity_of(state_field_, context, model_.name());
+      step.ms.velocity += clock.lap_ms();
+      if (banded_ && whole_surface_used_) {  // V^n couples d everywhere: banded, it must be asked again
+        const bool again = std::isfinite(distance_width_);
+        whole_surface();
+        step.ms.distance += clock.lap_ms();
+        if (again) continue;
+      }
+      if (!check_reach) break;
+      const double need = band_need(step_reach(state_velocity_, dt));
+      if (need <= distance_width_) break;
+      ensure_band(need);
+      step.ms.distance += clock.lap_ms();
     }
     step.ms.velocity += clock.lap_ms();
     if (attempt == 0 && hooks_.on_state) {  // outputs show the state T^n with d^n and V^n
@@ -347,6 +395,78 @@ class Evolution {
       step.ms.output += clock.lap_ms();
     }
     return state_velocity_;
+  }
+
+  /// One advection over the step in d^n's band: the vertices the front can reach are traced
+  /// (reach + 3 edges: the cut reads φ two rings beyond its crossed edges' vertices), the others
+  /// keep d^n, whose sign is all the cut reads there.
+  void band_step(LevelSetStep& step, const VectorField& velocity, double dt, int attempt) {
+    const double reach = step_reach(velocity, dt);
+    const std::vector<int> traced = within(distance_, reach + 3 * longest_edge_);
+    const std::vector<int> known = within(distance_, 2 * reach + 5 * longest_edge_);
+    Advector advector(mesh_, faces_around(mesh_, known));  // the walk's arrays for the band only
+    ScalarField next = distance_;
+    AdvectionReport report;
+    advector.advect_band(distance_, velocity, dt, traced, known, next, options_.advection, &report);
+    check_report(report);
+    if (report.outside_band > 0)  // band_need makes this impossible; a wrong front is never returned
+      throw NumericalError(fmt::format("step {} (t = {:.6g}): {} characteristics left the band of d^n (width {:.6g}, "
+                                       "reach {:.6g}); the step is not taken: set [time] narrow_band = false",
+                                       n_ + 1, t_, report.outside_band, distance_width_, reach));
+    model_.end_step(StepOutcome{mesh_, distance_, next, t_, dt, attempt, traced});
+    advance_substep(step, dt, dt, dt);
+    step.phi_next = std::move(next);
+    band_width_ = next_band_width(band_need(reach));
+  }
+
+  /// How far the characteristics of a step of `dt` go: max |V|·dt over the vertices where V is
+  /// known (d^n a distance there and one ring further: the conormal reads the ring).
+  double step_reach(const VectorField& velocity, double dt) const {
+    const double trusted = distance_width_ - 2 * longest_edge_;
+    double vmax = 0;
+    for (std::size_t i = 0; i < velocity.size(); ++i)
+      if (std::abs(distance_[i]) <= trusted) vmax = std::max(vmax, velocity[i].norm());
+    return vmax * dt;
+  }
+
+  /// The width of d^n a step of this reach reads: its traced vertices (reach + 3 edges), the faces
+  /// their characteristics cross (reach more, and a face), the gradients at those faces' corners
+  /// (a ring) and the conormal there (one more).
+  double band_need(double reach) const { return 2 * reach + 6 * longest_edge_; }
+  /// The width of the sub-steps' band (FrontSubsteps::width).
+  double front_band_width() const { return 2 * options_.max_cfl * cfl_length() + 5 * longest_edge_; }
+
+  /// The width the next state's d is measured with: half as much again as this step needed, so
+  /// that a front speeding up does not make every step widen it (and no wider than [distance]
+  /// narrow_band, when the case sets it).
+  double next_band_width(double need) const {
+    return std::max(need, std::min(1.5 * need, options_.distance.narrow_band));
+  }
+
+  /// The model couples every vertex (StepContext::whole_surface_used): d on the whole surface from
+  /// now on, d^n measured again.
+  void whole_surface() {
+    if (hooks_.log)
+      spdlog::info("n={}: model '{}' uses mass, stiffness or smoothing on the surface: d is measured on the whole "
+                   "surface from now on (ModelNeeds::whole_surface_distance says so from the start)",
+                   n_, model_.name());
+    banded_ = false;
+    band_width_ = INFINITY;
+    if (std::isfinite(distance_width_)) measure_distance(/*same_mesh=*/true);
+  }
+
+  /// d^n measured again when its band is narrower than `need` (a front faster than the last step's):
+  /// the band is detected too narrow and widened, never used as it is.
+  void ensure_band(double need) {
+    if (need <= distance_width_) return;
+    if (need > options_.distance.narrow_band)
+      throw InputError(fmt::format(
+          "step {} (t = {:.6g}): the step reads d up to {:.6g} from the front (twice its reach and 6 edges), beyond "
+          "[distance] narrow_band = {:.6g}: widen it, or leave it out (the driver sizes its band to each step)",
+          n_ + 1, t_, need, options_.distance.narrow_band));
+    spdlog::debug("n={}: d's band widened from {:.6g} to {:.6g}", n_, distance_width_, next_band_width(need));
+    band_width_ = next_band_width(need);
+    measure_distance(/*same_mesh=*/true);
   }
 
   /// One whole-surface advection sub-step: φ at its end.
@@ -447,7 +567,7 @@ class Evolution {
     try {
       return review_candidate(step, attempt);
     } catch (...) {
-      if (kept_mesh) mesh_ = *kept_mesh, distance_ = kept_distance, candidate_ = false;
+      if (kept_mesh) mesh_ = *kept_mesh, distance_ = kept_distance, distance_width_ = kept_width_, candidate_ = false;
       throw;
     }
   }
@@ -513,6 +633,11 @@ class Evolution {
   }
 
   EvolutionResult finish() {
+    // The final state's d on the whole surface (final.sol, the outputs, the model's finish): once.
+    if (banded_ && distance_width_ < options_.distance.narrow_band) {
+      banded_ = false;
+      measure_distance(/*same_mesh=*/true);
+    }
     result_.iteration = n_;
     result_.time = t_;
     result_.final_distance = distance_;
@@ -546,13 +671,19 @@ class Evolution {
   }
 
   // ---- helpers ---------------------------------------------------------------------------------
-  /// d of the current mesh; its solver is kept for the sub-steps of the next step (same mesh).
-  void measure_distance() {
-    solver_.emplace(mesh_);
-    distance_ = distance_of(mesh_, *solver_, options_.distance);
+  /// d of the current mesh, in a band of band_width_ when banded_; its solver is kept for the
+  /// sub-steps of the next step (same mesh).
+  void measure_distance(bool same_mesh = false) {
+    if (!same_mesh || !solver_) solver_.emplace(mesh_);
+    if (!same_mesh) longest_edge_ = edge_length_stats(mesh_).max;
+    DistanceOptions options = options_.distance;
+    if (banded_) options.narrow_band = std::min(options.narrow_band, band_width_);
+    distance_ = distance_of(mesh_, *solver_, options);
+    distance_width_ = options.narrow_band;
+    ++distance_version_;
   }
   StepContext context_for(const SurfaceMesh& mesh, const ScalarField& d, int iteration, double time, double dt,
-                          std::span<const int> active = {}, StepGeometry* geometry = nullptr) const {
+                          std::span<const int> active = {}, StepGeometry* geometry = nullptr) {
     return make_step_context(StepState{.mesh = &mesh,
                                        .distance = &d,
                                        .time = time,
@@ -563,7 +694,8 @@ class Evolution {
                                        .clock_start = options_.clock_start,
                                        .active = active,
                                        .geometry = geometry,
-                                       .surface = options_.remesh.reference.get()});
+                                       .surface = options_.remesh.reference.get(),
+                                       .whole_surface_used = &whole_surface_used_});
   }
   void stop(StopReason reason, std::string message) {
     stopped_ = true;
@@ -576,10 +708,19 @@ class Evolution {
   const EvolutionOptions& options_;
   const EvolutionHooks& hooks_;
   const ModelNeeds needs_;
+  /// d^n and the advection in a band of the front (narrow_band); off for good once the model asks
+  /// for an operator coupling every vertex (whole_surface_used_, raised by its StepContext).
+  bool banded_;
+  bool whole_surface_used_ = false;
+  int distance_version_ = 0;    ///< counts measure_distance (a sub-step set-up made on an older d is stale)
   int n_;
   double t_;
   double dt_;                   ///< Δt of the next step (the case's, or the model's latest)
   ScalarField distance_;        ///< d of the current state (or of the candidate, in steps 3-5)
+  /// d's band: distance_ is exact within distance_width_ of Σ, ±it beyond (∞: the whole surface);
+  /// band_width_ is what the next measure uses (∞ until a step has sized it).
+  double distance_width_ = INFINITY, band_width_ = INFINITY, kept_width_ = INFINITY;
+  double longest_edge_ = 0;     ///< of the current mesh
   std::optional<DistanceSolver> solver_;  ///< on the current mesh (distance_'s, then the sub-steps')
   VelocityField state_field_;   ///< the model's answer on T^n (first sub-step of the first attempt)
   VectorField state_velocity_;  ///< V^n

@@ -182,7 +182,9 @@ void GuardedModel::configure(Parameters& parameters) {
 }
 
 ModelNeeds GuardedModel::needs() const {
-  return guarded("needs", iteration_, [&] { return model_.needs(); });
+  ModelNeeds needs = guarded("needs", iteration_, [&] { return model_.needs(); });
+  if (!plugin_has(abi_, kAbiBandedDistance)) needs.whole_surface_distance = true;
+  return needs;
 }
 
 VelocityField GuardedModel::compute(const StepContext& context) {

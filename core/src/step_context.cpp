@@ -74,15 +74,21 @@ struct StepContext::Impl {
     std::lock_guard lock(state.geometry->mutex);
     return compute(state.geometry->surface_normals);
   }
+  void couples_every_vertex() const {
+    if (state.whole_surface_used) *state.whole_surface_used = true;
+  }
   const Eigen::SparseMatrix<double>& mass_locked() const {
+    couples_every_vertex();
     if (!mass) mass = bodyfit::mass_matrix(mesh());
     return *mass;
   }
   const Eigen::SparseMatrix<double>& stiffness_locked() const {
+    couples_every_vertex();
     if (!stiffness) stiffness = bodyfit::stiffness_matrix(mesh());
     return *stiffness;
   }
   const H1Smoother& smoother_locked(double length) const {
+    couples_every_vertex();
     auto it = smoothers.find(length);
     if (it == smoothers.end())
       it = smoothers.emplace(length, H1Smoother(mass_locked(), stiffness_locked(), length, vertex_normals_locked()))
@@ -115,7 +121,8 @@ StepContext StepContext::standalone(const SurfaceMesh& mesh, const ScalarField& 
                                      .clock_start = where.clock_start,
                                      .active = {},
                                      .geometry = nullptr,
-                                     .surface = where.surface});
+                                     .surface = where.surface,
+                                     .whole_surface_used = nullptr});
 }
 
 const SurfaceMesh& StepContext::mesh() const { return *impl_->state.mesh; }

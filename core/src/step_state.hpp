@@ -28,6 +28,9 @@ struct StepState {
   std::span<const int> active;            ///< narrow band: where V is needed (empty: every vertex)
   StepGeometry* geometry = nullptr;       ///< shared with the other contexts of the step (optional)
   const ReferenceSurface* surface = nullptr;  ///< the fixed input surface S (optional)
+  /// Raised when the model asks for an operator that couples every vertex (mass, stiffness,
+  /// smoothing): d must then be known on the whole surface (optional).
+  bool* whole_surface_used = nullptr;
 };
 
 /// The context for one (sub-)step or candidate; `state`'s pointers must outlive it.

@@ -14,42 +14,55 @@
 
 namespace bodyfit::walker {
 
-Surface build_surface(const SurfaceMesh& mesh) {
+Surface build_surface(const SurfaceMesh& mesh, std::span<const int> subset) {
   Surface s;
-  const int nf = int(mesh.n_faces());
+  const bool partial = !subset.empty();
+  const int nf = partial ? int(subset.size()) : int(mesh.n_faces());  // faces built
   const int nv = int(mesh.n_vertices());
+  auto face_at = [&](int k) { return partial ? subset[std::size_t(k)] : k; };
   s.points.resize(nv);
   for (int v = 0; v < nv; ++v) s.points[v] = mesh.point(VertexHandle(v));
   // Connectivity as flat arrays, read once from the halfedges: corner i of a face is the target of
-  // its halfedge h_i, and the edge opposite corner i is that of h_{i+2}.
+  // its halfedge h_i, and the edge opposite corner i is that of h_{i+2} (mesh face indices).
   std::vector<std::array<int, 3>> corners(nf), across(nf);
   tbb::parallel_for(tbb::blocked_range<int>(0, nf, 4096), [&](const tbb::blocked_range<int>& range) {
-    for (int fi = range.begin(); fi != range.end(); ++fi) {
-      HalfedgeHandle h = mesh.halfedge_handle(FaceHandle(fi));
+    for (int k = range.begin(); k != range.end(); ++k) {
+      HalfedgeHandle h = mesh.halfedge_handle(FaceHandle(face_at(k)));
       for (int i = 0; i < 3; ++i) {
-        corners[fi][i] = mesh.to_vertex_handle(h).idx();
+        corners[k][i] = mesh.to_vertex_handle(h).idx();
         const HalfedgeHandle o = mesh.opposite_halfedge_handle(h);
-        across[fi][(i + 1) % 3] = mesh.is_boundary(o) ? -1 : mesh.face_handle(o).idx();
+        across[k][(i + 1) % 3] = mesh.is_boundary(o) ? -1 : mesh.face_handle(o).idx();
         h = mesh.next_halfedge_handle(h);
       }
     }
   });
-  // Vertices in Z-order, faces in the order of their first corner in it (a counting sort): a walk's
-  // next face is then usually close in memory, and so are the faces of neighbouring vertices.
-  s.vertex_order = z_order(s.points);
+  // Vertices in Z-order (a partial surface: in index order), faces in the order of their first
+  // corner in it (a counting sort): a walk's next face is then usually close in memory, and so are
+  // the faces of neighbouring vertices.
   std::vector<int>& rank = s.vertex_rank;
   rank.resize(nv);
-  for (int k = 0; k < nv; ++k) rank[s.vertex_order[k]] = k;
-  std::vector<int> start(std::size_t(nv) + 1, 0);
-  for (int fi = 0; fi < nf; ++fi)
-    ++start[1 + std::min({rank[corners[fi][0]], rank[corners[fi][1]], rank[corners[fi][2]]})];
-  for (int k = 0; k < nv; ++k) start[k + 1] += start[k];
-  std::vector<int> slot_of(nf), face_order(nf);
-  for (int fi = 0; fi < nf; ++fi) {
-    const int key = std::min({rank[corners[fi][0]], rank[corners[fi][1]], rank[corners[fi][2]]});
-    slot_of[fi] = start[key]++;
-    face_order[slot_of[fi]] = fi;
+  if (partial) {
+    std::iota(rank.begin(), rank.end(), 0);
+    std::vector<char> used(nv, 0);
+    for (const auto& c : corners) used[c[0]] = used[c[1]] = used[c[2]] = 1;
+    for (int v = 0; v < nv; ++v)
+      if (used[v]) s.vertex_order.push_back(v);
+  } else {
+    s.vertex_order = z_order(s.points);
+    for (int k = 0; k < nv; ++k) rank[s.vertex_order[k]] = k;
   }
+  std::vector<int> start(std::size_t(nv) + 1, 0);
+  for (int k = 0; k < nf; ++k) ++start[1 + std::min({rank[corners[k][0]], rank[corners[k][1]], rank[corners[k][2]]})];
+  for (int k = 0; k < nv; ++k) start[k + 1] += start[k];
+  // Mesh face → its slot (−1: not built), and → its row in corners.
+  std::vector<int> slot_of(mesh.n_faces(), -1), row_of(partial ? mesh.n_faces() : 0, -1), face_order(nf);
+  for (int k = 0; k < nf; ++k) {
+    const int key = std::min({rank[corners[k][0]], rank[corners[k][1]], rank[corners[k][2]]});
+    slot_of[face_at(k)] = start[key]++;
+    face_order[slot_of[face_at(k)]] = k;
+    if (partial) row_of[face_at(k)] = k;
+  }
+  auto row = [&](int face) { return partial ? row_of[face] : face; };
   s.faces.resize(nf);
   s.motion.resize(nf);
   s.corners.resize(nf);
@@ -74,8 +87,13 @@ Surface build_surface(const SurfaceMesh& mesh) {
         f.across[i] = 0;
         f.unfold_far[i] = 0;
         f.unfold_next[i] = 0;
-        const int g = across[fi][i];
-        if (g < 0) continue;
+        const int g_face = across[fi][i];
+        if (g_face < 0) continue;
+        if (slot_of[g_face] < 0) {  // a face of the mesh that is not built
+          f.neighbour[i] = kNotBuilt;
+          continue;
+        }
+        const int g = row(g_face);
         // Slots in g: the corner that is not on the shared edge, and this face's corner i + 1.
         int slot_far = 0, slot_next = 0;
         for (int j = 0; j < 3; ++j) {
@@ -97,7 +115,7 @@ Surface build_surface(const SurfaceMesh& mesh) {
         const double alpha = -away * gi;  // λ_i at the unfolded corner
         if (!(alpha < 0)) continue;       // the neighbour is degenerate: leave the edge closed
         const Vec3 unfolded_rel = along * e - (away / gi) * grad[i];
-        f.neighbour[i] = slot_of[g];
+        f.neighbour[i] = slot_of[g_face];
         f.across[i] = static_cast<unsigned char>(slot_far | (slot_next << 2));
         f.unfold_far[i] = 1.0 / alpha;
         f.unfold_next[i] = 1.0 + OpenMesh::dot(grad[i1], unfolded_rel);

@@ -7,6 +7,7 @@
 #include <bodyfit/mesh.hpp>
 
 #include <array>
+#include <span>
 #include <cstdint>
 #include <vector>
 
@@ -27,7 +28,7 @@ struct alignas(64) Face {
   double unfold_far[3];
   /// The coordinate for corner (i + 1) % 3 of that unfolded far corner.
   double unfold_next[3];
-  int neighbour[3];  ///< face across the edge opposite corner i, −1 on the boundary
+  int neighbour[3];  ///< face across the edge opposite corner i, −1 on the boundary, kNotBuilt
   /// In the neighbour across edge i: bits 0–1 the slot of the corner opposite that edge, bits 2–3
   /// the slot of this face's corner (i + 1) % 3 (the third slot holds corner (i + 2) % 3).
   unsigned char across[3];
@@ -56,6 +57,9 @@ inline Delta operator+(const Delta& a, const Delta& b) {
   return {{a.d[0] + b.d[0], a.d[1] + b.d[1], a.d[2] + b.d[2]}};
 }
 
+/// Face::neighbour of an edge whose other face exists but is not in a partial Surface.
+constexpr int kNotBuilt = -2;
+
 struct Surface {
   std::vector<Face> faces;
   std::vector<FaceMotion> motion;
@@ -70,8 +74,10 @@ struct Surface {
   double shortest_face = 0;              ///< the smallest of them (> 0 on a mesh that was read)
 };
 
-/// The walk's geometry (everything but the velocity), in Z-order.
-Surface build_surface(const SurfaceMesh& mesh);
+/// The walk's geometry (everything but the velocity), in Z-order. With `faces` (indices into the
+/// mesh), only those: their edges towards the other faces are kNotBuilt, where a walk ends as
+/// WalkEnd::left; the vertices' order is their index order (canonical meshes are in Z-order).
+Surface build_surface(const SurfaceMesh& mesh, std::span<const int> faces = {});
 
 /// V on the face in `slot` as coordinate increments per unit time at its corners.
 inline void fill_motion(Surface& s, int slot, const VectorField& velocity, std::uint32_t epoch) {
@@ -94,7 +100,8 @@ struct Location {
   double b[3] = {1, 0, 0};
 };
 
-enum class WalkEnd { arrived, boundary, stalled };
+/// left: reached an edge whose other face is not in the (partial) Surface.
+enum class WalkEnd { arrived, boundary, left, stalled };
 
 /// Crossings allowed in one walk before it is declared stalled (a sub-step crosses about one face;
 /// turning around a vertex takes at most its valence in zero-length crossings).
@@ -172,12 +179,12 @@ inline double pick(const double (&a)[3], int i) { return i == 0 ? a[0] : i == 1 
     const double reached1 = std::max(pick(b, i1) + t_exit * (pick(e, i1) - pick(b, i1)), 0.0);
     const double reached2 = std::max(pick(b, i2) + t_exit * (pick(e, i2) - pick(b, i2)), 0.0);
     const int g = f.neighbour[exit];
-    if (g < 0) {  // leaves the surface: stop on the boundary edge
+    if (g < 0) {  // leaves the surface (or what was built of it): stop on the edge
       at.face = face;
       at.b[exit] = 0.0;
       at.b[i1] = reached1;
       at.b[i2] = reached2;
-      return WalkEnd::boundary;
+      return g == kNotBuilt ? WalkEnd::left : WalkEnd::boundary;
     }
     // Into the neighbour's slots: jo opposite the edge, jn this face's corner i1, jt its corner i2.
     // The permutation is done with selects, in registers: stores through a variable index would

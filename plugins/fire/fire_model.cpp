@@ -340,6 +340,10 @@ class FireModel final : public VelocityModel {
     }
   }
 
+  // d on the whole surface: ros_all_mean/max are R over every vertex of the landscape, each with
+  // the extended n_Σ, which a band of d leaves undefined beyond its width.
+  ModelNeeds needs() const override { return {.whole_surface_distance = true}; }
+
   VelocityField compute(const StepContext& context) override {
     const SurfaceMesh& mesh = context.mesh();
     const VectorField& conormal = context.conormal();

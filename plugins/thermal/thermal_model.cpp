@@ -294,7 +294,10 @@ class ThermalModel final : public VelocityModel {
     if (!sharp_) p.not_used("sharp_every", "sharp = false");
   }
 
-  ModelNeeds needs() const override { return {.may_reject = true, .freeze_velocity = true}; }
+  // d everywhere: the shape gradient is extended over the whole skin, and nucleation looks for sites anywhere.
+  ModelNeeds needs() const override {
+    return {.may_reject = true, .freeze_velocity = true, .whole_surface_distance = true};
+  }
 
   VelocityField compute(const StepContext& context) override {
     resolve_lengths(context);

@@ -51,6 +51,10 @@ ScalarField advect(const SurfaceMesh& mesh, const ScalarField& phi, const Vector
 class Advector {
  public:
   explicit Advector(const SurfaceMesh& mesh);
+  /// Only the faces `faces` (mesh indices), for band calls whose `known` vertices have all their
+  /// faces among them: its cost follows the band, not the mesh. A trace reaching a face that is
+  /// not built has left the band (AdvectionReport::outside_band).
+  Advector(const SurfaceMesh& mesh, std::span<const int> faces);
   ~Advector();
   Advector(Advector&&) noexcept;
 

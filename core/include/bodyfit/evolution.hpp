@@ -93,12 +93,18 @@ struct EvolutionOptions {
   /// Only the front matters: max|V| is taken over the vertices within the band's width of Σ (see
   /// narrow_band), where the front can be within the step's reach.
   double max_cfl = 0;
-  /// With max_cfl, work near the front only: the sub-steps after the first redistance φ, ask the
-  /// model for V (StepContext::active_vertices) and advect φ in a band of width 2·max_cfl·h + 4·ĥ
-  /// (ĥ the longest edge) around the moving front, tracing the vertices within max_cfl·h + 2·ĥ:
-  /// the front cannot leave that within a sub-step, so the result is the whole surface's (the
-  /// vertices beyond keep their sign). A sub-step then costs what the band holds, not the mesh.
-  /// false: every stage on the whole surface (the reference the band is tested against).
+  /// Work near the front only. d^n is measured within a band of Σ that holds what the step reads
+  /// (±the band's width beyond: StepContext::distance), sized by the last step (1.5× its need) and
+  /// widened, d measured again, when a step needs more (a faster front); unless the model asks for
+  /// the whole surface (ModelNeeds::whole_surface_distance) or freezes V over CFL sub-steps.
+  /// One advection over Δt traces the vertices within reach + 3·ĥ (reach = max|V|·Δt, ĥ the
+  /// longest edge), reading d and V within 2·reach + 5·ĥ; with max_cfl the sub-steps after the first
+  /// redistance φ, ask the model for V (StepContext::active_vertices) and advect φ in a band of
+  /// width 2·max_cfl·h + 5·ĥ around the moving front, tracing the vertices within max_cfl·h + 3·ĥ.
+  /// The front cannot leave those within a (sub-)step, so the cut gets the whole surface's φ
+  /// wherever it reads it (the vertices beyond keep their sign). A step then costs what the band
+  /// holds, not the mesh. false: every stage on the whole surface (the reference the band is
+  /// tested against).
   bool narrow_band = true;
   /// With max_cfl: the sub-steps' redistancing keeps φ at the vertices of the faces its zero set
   /// crosses (DistanceOptions::keep_crossings), so that only the advection moves the front. false:

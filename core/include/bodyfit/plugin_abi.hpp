@@ -18,7 +18,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 3;
-inline constexpr std::uint32_t kPluginAbiMinor = 1;
+inline constexpr std::uint32_t kPluginAbiMinor = 2;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// A feature of the plugin interface and the ABI version that brought it.
@@ -39,6 +39,11 @@ inline constexpr AbiFeature kAbiSurfaceSource{3, 0, "surface source"};
 // The features of ABI 3.1.
 /// New components of G named by the model (VelocityModel::nuclei).
 inline constexpr AbiFeature kAbiNuclei{3, 1, "nuclei"};
+
+// The features of ABI 3.2.
+/// ModelNeeds::whole_surface_distance: a model built before it gets d on the whole surface (its
+/// needs() returns the shorter struct, and its author did not know d could be banded).
+inline constexpr AbiFeature kAbiBandedDistance{3, 2, "banded distance"};
 
 /// Whether a plugin built for `abi` has `feature`.
 constexpr bool plugin_has(std::uint32_t abi, AbiFeature feature) {

@@ -103,7 +103,10 @@ class StepContext {
   StepContext& operator=(const StepContext&) = delete;
 
   const SurfaceMesh& mesh() const;     ///< T^n: regions (f:region), interface (e:interface)
-  const ScalarField& distance() const; ///< signed geodesic distance d_{G^n}, < 0 inside
+  /// Signed geodesic distance d_{G^n}, < 0 inside. In a narrow band (EvolutionOptions::narrow_band,
+  /// unless ModelNeeds::whole_surface_distance) exact within the band's width of Σ, which holds
+  /// every point the step's characteristics reach; beyond, ±that width.
+  const ScalarField& distance() const;
   /// t^n; in a CFL sub-step after the first, the sub-step's own start (t^n + the time advanced):
   /// a model whose V depends on time (data given in time) evaluates it there.
   double time() const;
@@ -137,7 +140,9 @@ class StepContext {
   /// Per-face and per-vertex tangential gradients of a P1 field.
   VectorField face_gradients(const ScalarField& u) const;
   VectorField vertex_gradients(const ScalarField& u) const;
-  /// P1 mass and stiffness matrices on T^n (vertex-indexed).
+  /// P1 mass and stiffness matrices on T^n (vertex-indexed). They and smooth() couple every
+  /// vertex: asking for them in compute() makes the driver measure d on the whole surface from
+  /// then on (as ModelNeeds::whole_surface_distance does from the start).
   const Eigen::SparseMatrix<double>& mass_matrix() const;
   const Eigen::SparseMatrix<double>& stiffness_matrix() const;
   /// The lumped mass: a third of the area of the faces around each vertex (the row sums of M).
@@ -183,6 +188,11 @@ struct ModelNeeds {
   /// With CFL sub-steps, compute V once per step on T^n and advect with it over every sub-step
   /// (a PDE-based model solves once per step, not once per sub-step).
   bool freeze_velocity = false;
+  /// The model reads d (or what is computed from it: the conormal, the front's curvature) farther
+  /// from Σ than a step can move it — a statistic over the whole surface, a PDE or a smoothing.
+  /// Otherwise (EvolutionOptions::narrow_band) the driver computes d^n only within a band of Σ
+  /// that holds what the step can reach: beyond it d is ±the band's width (sign right).
+  bool whole_surface_distance = false;
 };
 
 /// A model's verdict on a candidate T^{n+1}.
