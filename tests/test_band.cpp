@@ -70,9 +70,10 @@ struct Run {
 };
 
 Run run_cap(bool narrow_band, double fast = 1.0, double switch_time = 0.0, bool smoothing = false,
-            double distance_band = INFINITY) {
+            double distance_band = INFINITY, double max_cfl = 0) {
   CaseSetup setup = setup_case(parse_case(toml::parse(kCap)));
   setup.options.narrow_band = narrow_band;
+  setup.options.max_cfl = max_cfl;
   setup.options.distance.narrow_band = distance_band;
   Conormal model(fast, switch_time, smoothing);
   Run out;
@@ -140,6 +141,15 @@ TEST_CASE("a run in a band gives the whole surface's fronts, and its model sees 
     CHECK(whole.largest_d.at(n) > 2.0);
     CHECK(banded.largest_d.at(n) < 0.7 * whole.largest_d.at(n));
   }
+}
+
+TEST_CASE("CFL sub-steps on a banded d: the whole surface's fronts") {
+  // Each step of 0.05 is made of sub-steps moving the front at most max_cfl·h ≈ 0.025.
+  const Run banded = run_cap(true, 1.0, 0.0, false, INFINITY, 0.25), whole = run_cap(false, 1.0, 0.0, false, INFINITY, 0.25);
+  check_same_fronts(banded.result, whole.result);
+  for (const auto& record : banded.result.records)
+    if (record.iteration > 0) CHECK(record.substeps >= 2);
+  CHECK(banded.largest_d.at(2) < 0.7 * whole.largest_d.at(2));
 }
 
 TEST_CASE("a front that speeds up 8×: the band is found too narrow, widened, and the front is the whole surface's") {
