@@ -61,6 +61,7 @@ void CheckpointWriter::start() {
     } catch (...) {
       error_ = std::current_exception();
     }
+    snapshot_.release();  // written (or failed): not held until the next one
   });
 }
 

@@ -498,6 +498,10 @@ class CrossingSlopes {
 void split_crossed_edges(SurfaceMesh& mesh, ScalarField& value, const std::vector<EdgeHandle>& crossed,
                          const CrossingSlopes& slope_of, const DiscretizeOptions& options) {
   value.reserve(value.size() + crossed.size());
+  // Each split adds a vertex, three edges and two faces: reserved at once, or the arrays double
+  // their capacity on the way (at a million faces, the peak of the whole run).
+  const std::size_t k = crossed.size();
+  mesh.reserve(mesh.n_vertices() + k, mesh.n_edges() + 3 * k, mesh.n_faces() + 2 * k);
   for (auto e : crossed) {
     auto h = mesh.halfedge_handle(e, 0);
     auto a = mesh.from_vertex_handle(h), b = mesh.to_vertex_handle(h);

@@ -46,6 +46,12 @@ class CheckpointSnapshot {
   std::string_view bytes() const { return {data_.get(), size_}; }
   /// Compute the checksum over the rest (the slow part after the copy: done by the writer).
   void seal();
+  /// Give the memory back (the next take_snapshot allocates again): a snapshot is the size of the
+  /// mesh, which a run should not hold between checkpoints.
+  void release() {
+    data_.reset();
+    size_ = capacity_ = 0;
+  }
 
  private:
   friend void take_snapshot(CheckpointSnapshot&, const SurfaceMesh&, const RunState&, const ModelState*,
