@@ -482,6 +482,48 @@ TEST_CASE("Advector::advect_band: the whole-mesh advection at the traced vertice
   CHECK(report.outside_band > 0);
 }
 
+TEST_CASE("an Advector built on the band's faces only: the whole mesh's band call, and traces leaving it are counted") {
+  // Its faces are stored in the whole mesh's order and each trace starts in the same face of its
+  // vertex: the same values, bit for bit.
+  const SurfaceMesh mesh = make_sphere({.faces = 20 * 22 * 22});
+  const double h = edge_length_stats(mesh).mean;
+  ScalarField phi(mesh.n_vertices());
+  for (auto v : mesh.vertices()) phi[v.idx()] = std::acos(std::clamp(mesh.point(v)[2], -1.0, 1.0)) - M_PI / 3;
+  const VectorField velocity =
+      sample_vector(mesh, [](const Vec3& p) { return e_beta(p) + 0.5 * OpenMesh::cross(Vec3(0, 0, 1), p); });
+  const double T = 3 * h;
+  std::vector<int> traced, known;
+  for (auto v : mesh.vertices()) {
+    if (std::abs(phi[v.idx()]) <= 2 * h) traced.push_back(v.idx());
+    if (std::abs(phi[v.idx()]) <= 8 * h) known.push_back(v.idx());
+  }
+  std::vector<int> faces;  // the faces with a corner in `known`
+  for (auto f : mesh.faces())
+    for (auto v : mesh.fv_range(f))
+      if (std::binary_search(known.begin(), known.end(), v.idx())) {
+        faces.push_back(f.idx());
+        break;
+      }
+  REQUIRE(faces.size() < mesh.n_faces() / 2);
+  Advector whole(mesh), band(mesh, faces);
+  ScalarField expected(mesh.n_vertices(), 7.0), out(mesh.n_vertices(), 7.0);
+  AdvectionReport report;
+  whole.advect_band(phi, velocity, T, traced, known, expected);
+  band.advect_band(phi, velocity, T, traced, known, out, {}, &report);
+  CHECK(report.outside_band == 0);
+  CHECK(report.hit_boundary == 0);
+  CHECK(report.lost == 0);
+  std::size_t differ = 0;
+  for (std::size_t v = 0; v < out.size(); ++v) differ += out[v] != expected[v];
+  CHECK(differ == 0);
+  // Too long a time for the faces built: the traces reach their edge and are counted as having
+  // left the band, never as having met a boundary of S (a closed sphere has none).
+  band.advect_band(phi, velocity, 10 * T, traced, known, out, {}, &report);
+  CHECK(report.outside_band > 0);
+  CHECK(report.hit_boundary == 0);
+  CHECK_THROWS_AS(band.advect(phi, velocity, T), std::logic_error);
+}
+
 TEST_CASE("Advector::advect_band_composed: sub-steps of a translation give the one-step result, not K interpolations") {
   // A uniform V on a plane: the composed foot map is affine, so its interpolation is exact and K
   // composed calls of T/K interpolate phi once, at the same foot as one call of T. Interpolating phi

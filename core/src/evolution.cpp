@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <chrono>
@@ -97,6 +99,17 @@ std::vector<int> within(const ScalarField& phi, double width) {
   for (std::size_t i = 0; i < phi.size(); ++i)
     if (std::abs(phi[i]) <= width) band.push_back(int(i));
   return band;
+}
+
+/// The longest edge of a garbage-collected mesh (a parallel max: the same for any thread count).
+double longest_edge(const SurfaceMesh& mesh) {
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, int(mesh.n_edges()), 16384), 0.0,
+      [&](const tbb::blocked_range<int>& range, double longest) {
+        for (int e = range.begin(); e != range.end(); ++e) longest = std::max(longest, edge_length(mesh, EdgeHandle(e)));
+        return longest;
+      },
+      [](double a, double b) { return std::max(a, b); });
 }
 
 /// The faces with a corner among `vertices`, each once, in index order.
@@ -638,6 +651,7 @@ class Evolution {
       banded_ = false;
       measure_distance(/*same_mesh=*/true);
     }
+    solver_.reset();
     result_.iteration = n_;
     result_.time = t_;
     result_.final_distance = distance_;
@@ -672,20 +686,25 @@ class Evolution {
 
   // ---- helpers ---------------------------------------------------------------------------------
   /// d of the current mesh, in a band of band_width_ when banded_; its solver is kept for the
-  /// sub-steps of the next step (same mesh).
+  /// CFL sub-steps of the next step (same mesh).
   void measure_distance(bool same_mesh = false) {
     if (!same_mesh || !solver_) solver_.emplace(mesh_);
-    if (!same_mesh) longest_edge_ = edge_length_stats(mesh_).max;
+    if (!same_mesh) longest_edge_ = longest_edge(mesh_);
     DistanceOptions options = options_.distance;
     if (banded_) options.narrow_band = std::min(options.narrow_band, band_width_);
     distance_ = distance_of(mesh_, *solver_, options);
     distance_width_ = options.narrow_band;
     ++distance_version_;
+    // Only CFL sub-steps redistance on this mesh again: otherwise its arrays (about the mesh's own
+    // size) are not held through the step.
+    if (!(options_.max_cfl > 0)) solver_.reset();
   }
   StepContext context_for(const SurfaceMesh& mesh, const ScalarField& d, int iteration, double time, double dt,
                           std::span<const int> active = {}, StepGeometry* geometry = nullptr) {
     return make_step_context(StepState{.mesh = &mesh,
                                        .distance = &d,
+                                       // distance_'s band (a sub-step's φ is redistanced in its own)
+                                       .distance_width = &d == &distance_ ? distance_width_ : INFINITY,
                                        .time = time,
                                        .dt = dt,
                                        .iteration = iteration,

@@ -212,6 +212,10 @@ std::vector<int> z_order(const std::vector<Vec3>& points) {
     box.min.minimize(p);
     box.max.maximize(p);
   }
+  return z_order(points, box);
+}
+
+std::vector<int> z_order(const std::vector<Vec3>& points, const BoundingBox& box) {
   const Vec3 extent = box.max - box.min;
   const double scale = double((1 << 21) - 1);
   const int n = int(points.size());

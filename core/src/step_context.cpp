@@ -183,7 +183,24 @@ const VectorField& StepContext::conormal() const {
     };
     VectorField n;
     const std::span<const int> active = impl_->state.active;
-    if (active.empty()) {
+    const double width = impl_->state.distance_width;
+    if (active.empty() && std::isfinite(width)) {
+      // d banded: beyond the band and its ring every face is flat (±width), n_Σ is 0 there. The
+      // band's vertices and their ring get the whole-surface values, bit for bit.
+      const SurfaceMesh& m = mesh();
+      const ScalarField& d = distance();
+      std::vector<char> near(m.n_vertices(), 0);
+      for (auto v : m.vertices())
+        if (std::abs(d[v.idx()]) < width) {
+          near[v.idx()] = 1;
+          for (auto w : m.vv_range(v)) near[w.idx()] = 1;
+        }
+      std::vector<int> where;
+      for (std::size_t v = 0; v < near.size(); ++v)
+        if (near[v]) where.push_back(int(v));
+      n = bodyfit::vertex_gradients(m, d, where);
+      for (int v : where) n[v] = unit(n[v]);
+    } else if (active.empty()) {
       n = bodyfit::vertex_gradients(mesh(), distance());
       for (auto& g : n) g = unit(g);
     } else {

@@ -4,6 +4,7 @@
 #include <bodyfit/velocity_model.hpp>
 
 #include <filesystem>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -20,6 +21,8 @@ struct StepGeometry {
 struct StepState {
   const SurfaceMesh* mesh = nullptr;      ///< T^n (garbage-collected)
   const ScalarField* distance = nullptr;  ///< d_{G^n} at the vertices
+  /// d is a distance within this width of Σ and ± it beyond (EvolutionOptions::narrow_band).
+  double distance_width = std::numeric_limits<double>::infinity();
   double time = 0, dt = 0;
   int iteration = 0;
   std::filesystem::path output_dir;

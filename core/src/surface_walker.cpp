@@ -36,18 +36,26 @@ Surface build_surface(const SurfaceMesh& mesh, std::span<const int> subset) {
       }
     }
   });
-  // Vertices in Z-order (a partial surface: in index order), faces in the order of their first
-  // corner in it (a counting sort): a walk's next face is then usually close in memory, and so are
-  // the faces of neighbouring vertices.
+  // Vertices in Z-order, faces in the order of their first corner in it (a counting sort): a walk's
+  // next face is then usually close in memory, and so are the faces of neighbouring vertices. A
+  // partial surface orders its vertices as the whole one would (codes in the whole mesh's box), so
+  // its faces are stored alike and a trace starts in the same face of its vertex: the same values.
   std::vector<int>& rank = s.vertex_rank;
-  rank.resize(nv);
   if (partial) {
-    std::iota(rank.begin(), rank.end(), 0);
+    rank.assign(nv, nv);  // the vertices not built come last
     std::vector<char> used(nv, 0);
     for (const auto& c : corners) used[c[0]] = used[c[1]] = used[c[2]] = 1;
+    std::vector<int> built;
+    std::vector<Vec3> points;
     for (int v = 0; v < nv; ++v)
-      if (used[v]) s.vertex_order.push_back(v);
+      if (used[v]) built.push_back(v), points.push_back(s.points[v]);
+    BoundingBox box;
+    if (nv > 0) box.min = box.max = s.points[0];
+    for (const Vec3& p : s.points) box.min.minimize(p), box.max.maximize(p);
+    for (int k : z_order(points, box)) s.vertex_order.push_back(built[std::size_t(k)]);
+    for (int k = 0; k < int(s.vertex_order.size()); ++k) rank[s.vertex_order[std::size_t(k)]] = k;
   } else {
+    rank.resize(nv);
     s.vertex_order = z_order(s.points);
     for (int k = 0; k < nv; ++k) rank[s.vertex_order[k]] = k;
   }

@@ -52,8 +52,9 @@ class Advector {
  public:
   explicit Advector(const SurfaceMesh& mesh);
   /// Only the faces `faces` (mesh indices), for band calls whose `known` vertices have all their
-  /// faces among them: its cost follows the band, not the mesh. A trace reaching a face that is
-  /// not built has left the band (AdvectionReport::outside_band).
+  /// faces among them: its cost follows the band, not the mesh, and its values are the whole
+  /// mesh's band call's, bit for bit (its faces are stored in the same order). A trace reaching a
+  /// face that is not built has left the band (AdvectionReport::outside_band). advect() refuses.
   Advector(const SurfaceMesh& mesh, std::span<const int> faces);
   ~Advector();
   Advector(Advector&&) noexcept;

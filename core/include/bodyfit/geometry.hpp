@@ -57,6 +57,9 @@ BoundingBox bounding_box(const SurfaceMesh& mesh);
 /// Indices of the points sorted by their Z-order (Morton) code in the points' bounding box (21 bits
 /// per axis), ties by index: a deterministic, spatially coherent order for cache-friendly sweeps.
 std::vector<int> z_order(const std::vector<Vec3>& points);
+/// The same with the codes taken in `box` (which must hold the points): some of a larger set's
+/// points come out in the order they have in the whole set's z_order.
+std::vector<int> z_order(const std::vector<Vec3>& points, const BoundingBox& box);
 
 struct QualityStats {
   double min = 0, mean = 0, max = 0;
