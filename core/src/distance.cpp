@@ -207,7 +207,7 @@ class FastMarch {
         // The front's geodesic curvature at each vertex (FrontValue), carried from the interface's
         // when it is curved and front_curvature is on; otherwise fronts are straight (the planar update).
         track_(options.front_curvature && !seeds.bends.empty()),
-        gauss_(track_ ? m.nv : 0, kUnknown) {}
+        gauss_(track_ ? m.nv() : 0, kUnknown) {}
 
   /// Exact initialisation. Every vertex of a seed face is fixed to its Euclidean distance to the
   /// segments of the seed faces around it (those with a vertex in its 1-ring); on a smooth surface
@@ -224,7 +224,7 @@ class FastMarch {
       const int mark = base + int(i);
       ring.clear();
       for (int c = 0; c < 3; ++c) {
-        const int u = m_.corner_vertex[3 * seeds_.faces[i] + c];
+        const int u = m_.corner_vertex(3 * seeds_.faces[i] + c);
         stamp[u] = mark;
         ring.push_back(u);
         if (state_[u] == 0 && dist_[u] == kInf) w_.touched.push_back(u);
@@ -232,13 +232,17 @@ class FastMarch {
       }
       for (int depth = 0, begin = 0; depth < kNearRings; ++depth) {
         const int end = int(ring.size());
-        for (int r = begin; r < end; ++r)
-          for (int j = m_.fan_start[ring[r]]; j < m_.fan_start[ring[r] + 1]; ++j)
-            for (int x : {m_.fan[j].a, m_.fan[j].b})
+        for (int r = begin; r < end; ++r) {
+          const FanRange fan = m_.fan(ring[r]);
+          for (int j = fan.begin; j < fan.end; ++j) {
+            const FanTriangle t = m_.fan_triangle(j);
+            for (int x : {t.a, t.b})
               if (stamp[x] != mark) {
                 stamp[x] = mark;
                 ring.push_back(x);
               }
+          }
+        }
         begin = end;
       }
       for (int x : ring) set_nearest(x, i);
@@ -264,7 +268,7 @@ class FastMarch {
 
   /// x's distance to the segments of seed face i when it is the nearest so far.
   void set_nearest(int x, std::size_t i) {
-    const Vec3& p = m_.points[x];
+    const Vec3& p = m_.point(x);
     double best = dist_[x];
     int best_segment = -1;
     for (int k = seeds_.seg_start[i]; k < seeds_.seg_start[i + 1]; ++k) {
@@ -300,8 +304,9 @@ class FastMarch {
       if (dist_[v] == kInf) continue;
       if (state_[v] == 0) {
         double shortest = kInf;
-        for (int j = m_.fan_start[v]; j < m_.fan_start[v + 1]; ++j)
-          shortest = std::min(shortest, (m_.points[m_.fan[j].a] - m_.points[v]).sqrnorm());
+        const FanRange fan = m_.fan(v);
+        for (int j = fan.begin; j < fan.end; ++j)
+          shortest = std::min(shortest, (m_.point(m_.fan_triangle(j).a) - m_.point(v)).sqrnorm());
         state_[v] = dist_[v] * dist_[v] <= kNearRadius * kNearRadius * shortest ? 2 : 1;
       }
       if (state_[v] == 2) ++report.initialised;
@@ -318,12 +323,12 @@ class FastMarch {
 
   /// The update of the vertex at an obtuse corner through the two virtual triangles (x; a, r), (x; r, b).
   FrontValue split_update(int split) {
-    const ObtuseSplit& s = m_.splits[split];
+    const ObtuseSplit s = m_.split(split);
     FrontValue value;
     if (!known(s.vertex)) return value;
     const int f = s.corner / 3, c = s.corner % 3;
-    const int x = m_.corner_vertex[s.corner];
-    const int a = m_.corner_vertex[3 * f + (c + 1) % 3], b = m_.corner_vertex[3 * f + (c + 2) % 3];
+    const int x = m_.corner_vertex(s.corner);
+    const int a = m_.corner_vertex(3 * f + (c + 1) % 3), b = m_.corner_vertex(3 * f + (c + 2) % 3);
     if (known(a)) {
       const FrontValue first = update(s.first, a, s.vertex, x);
       if (first.d < value.d) value = first;
@@ -346,20 +351,22 @@ class FastMarch {
 
   /// v accepted at d: its neighbours' tentative values lowered through the triangles around it.
   void accept(int v, double d, MinHeap& heap) {
-    const Vec3& pv = m_.points[v];
-    for (int j = m_.fan_start[v]; j < m_.fan_start[v + 1]; ++j) {
-      const FanTriangle& t = m_.fan[j];
+    const Vec3& pv = m_.point(v);
+    const FanRange fan = m_.fan(v);
+    for (int j = fan.begin; j < fan.end; ++j) {
+      // By value: an update may build another fan and move the storage.
+      const FanTriangle t = m_.fan_triangle(j);
       for (int side = 0; side < 2; ++side) {
         const int x = side == 0 ? t.a : t.b;
         if (known(x)) continue;
         const int y = side == 0 ? t.b : t.a;
-        const Vec3& px = m_.points[x];
+        const Vec3& px = m_.point(x);
         const Vec3 ev = pv - px;
         FrontValue value;
         if (!(t.obtuse & (1 << side))) {
-          if (known(y)) value = update(corner_geometry(ev, m_.points[y] - px), v, y, x);
+          if (known(y)) value = update(corner_geometry(ev, m_.point(y) - px), v, y, x);
         } else {  // obtuse angle at x: the two acute virtual triangles of the unfolding
-          const int split = m_.obtuse[3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3];
+          const int split = m_.obtuse(3 * (t.corner / 3) + (t.corner % 3 + 1 + side) % 3);
           if (split >= 0) value = split_update(split);
         }
         if (value.d == kInf) {
@@ -370,9 +377,8 @@ class FastMarch {
       }
     }
     // v may be the unfolded vertex r of obtuse corners elsewhere: update those corners too.
-    for (int j = m_.split_start[v]; j < m_.split_start[v + 1]; ++j) {
-      const int split = m_.split_list[j];
-      const int x = m_.corner_vertex[m_.splits[split].corner];
+    for (int split = m_.first_split_at(v); split >= 0; split = m_.next_split(split)) {
+      const int x = m_.corner_vertex(m_.split(split).corner);
       if (known(x)) continue;
       lower(x, split_update(split), heap);
     }
@@ -401,7 +407,7 @@ class FastMarch {
 /// is in w.dist / w.state (accepted = 3) for the vertices of w.touched.
 void march(const FlatMesh& m, const Seeds& seeds, const DistanceOptions& options, MarchWorkspace& w,
            DistanceReport& report) {
-  w.prepare(m.nv, seeds.faces.size());
+  w.prepare(m.nv(), seeds.faces.size());
   report.has_interface = !seeds.faces.empty();
   FastMarch march(m, seeds, options, w);
   march.initialise();
@@ -422,7 +428,7 @@ ScalarField signed_result(const Seeds& seeds, const MarchWorkspace& w, double ba
 void keep_crossing_values(const FlatMesh& m, const Seeds& seeds, const ScalarField& phi, ScalarField& d) {
   for (int f : seeds.faces)
     for (int c = 0; c < 3; ++c) {
-      const int v = m.corner_vertex[3 * f + c];
+      const int v = m.corner_vertex(3 * f + c);
       d[v] = phi[v];
     }
 }
@@ -443,7 +449,7 @@ void check_level_set(const SurfaceMesh& mesh, const ScalarField& phi) {
 }  // namespace
 
 struct DistanceSolver::Impl {
-  explicit Impl(const SurfaceMesh& m) : mesh(m), flat(prepared_mesh(m)) {}
+  explicit Impl(const SurfaceMesh& m) : mesh(m), flat(m) {}
   const SurfaceMesh& mesh;
   FlatMesh flat;
   double setup_ms = 0;
@@ -458,6 +464,12 @@ struct DistanceSolver::Impl {
     DistanceReport local;
     local.setup_ms = std::exchange(setup_ms, 0.0);  // charged to the first call only
     auto start = std::chrono::steady_clock::now();
+    // A march over the whole surface reads all of it: built at once, in parallel where it can be.
+    if (!std::isfinite(options.narrow_band)) {
+      flat.build_all();
+      local.setup_ms += milliseconds_since(start);
+      start = std::chrono::steady_clock::now();
+    }
     const Seeds seeds = make_seeds(flat);
     local.init_ms = milliseconds_since(start);
     start = std::chrono::steady_clock::now();
@@ -494,20 +506,21 @@ std::vector<int> DistanceSolver::redistance(ScalarField& phi, double width, std:
                                             DistanceReport* report, const DistanceOptions& keep) {
   Impl& s = *impl_;
   const FlatMesh& m = s.flat;
-  if (phi.size() != m.nv) check_level_set(s.mesh, phi);
+  if (phi.size() != m.nv()) check_level_set(s.mesh, phi);
   if (!(width > 0)) throw InputError("redistance: the band width must be positive");
   DistanceReport local;
   auto start = std::chrono::steady_clock::now();
   // The zero set, in the faces around `near`: each face once.
   const std::uint32_t epoch = ++s.epoch;
-  s.face_seen.resize(m.nf, 0);
+  s.face_seen.resize(m.nf(), 0);
   Seeds seeds;
   seeds.seg_start.push_back(0);
   for (int v : near) {
     if (!std::isfinite(phi[v])) throw InputError(fmt::format("redistance: non-finite level set at vertex {}", v));
     if (phi[v] == 0) seeds.zeros.push_back(v);
-    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j) {
-      const int f = m.fan[j].corner / 3;
+    const FanRange fan = m.fan(v);
+    for (int j = fan.begin; j < fan.end; ++j) {
+      const int f = m.fan_triangle(j).corner / 3;
       if (s.face_seen[f] == epoch) continue;
       s.face_seen[f] = epoch;
       add_phi_seed(m, phi, f, seeds);
@@ -527,7 +540,7 @@ std::vector<int> DistanceSolver::redistance(ScalarField& phi, double width, std:
   std::vector<std::pair<int, double>> kept;
   if (keep.keep_crossings)
     for (int f : seeds.faces)
-      for (int c = 0; c < 3; ++c) kept.emplace_back(m.corner_vertex[3 * f + c], phi[m.corner_vertex[3 * f + c]]);
+      for (int c = 0; c < 3; ++c) kept.emplace_back(m.corner_vertex(3 * f + c), phi[m.corner_vertex(3 * f + c)]);
   for (int v : band) phi[v] = phi[v] > 0 ? s.workspace.dist[v] : phi[v] < 0 ? -s.workspace.dist[v] : 0.0;
   for (const auto& [v, value] : kept) phi[v] = value;
   local.march_ms = milliseconds_since(start);

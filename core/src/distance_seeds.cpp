@@ -13,11 +13,11 @@ void add_phi_seed(const FlatMesh& m, const ScalarField& phi, int f, Seeds& s) {
   std::array<Vec3, 3> zero;
   int count = 0;
   for (int c = 0; c < 3; ++c) {
-    const int a = m.corner_vertex[3 * f + c], b = m.corner_vertex[3 * f + (c + 1) % 3];
-    if (sign(a) == 0) zero[count++] = m.points[a];
+    const int a = m.corner_vertex(3 * f + c), b = m.corner_vertex(3 * f + (c + 1) % 3);
+    if (sign(a) == 0) zero[count++] = m.point(a);
     if (sign(a) * sign(b) < 0) {
       const double t = phi[a] / (phi[a] - phi[b]);  // scale-free
-      zero[count++] = m.points[a] + (m.points[b] - m.points[a]) * t;
+      zero[count++] = m.point(a) + (m.point(b) - m.point(a)) * t;
     }
   }
   if (count == 0) return;
@@ -31,13 +31,13 @@ void add_phi_seed(const FlatMesh& m, const ScalarField& phi, int f, Seeds& s) {
 
 Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
   Seeds s;
-  s.sign.resize(m.nv);
-  for (std::size_t v = 0; v < m.nv; ++v) {
+  s.sign.resize(m.nv());
+  for (std::size_t v = 0; v < m.nv(); ++v) {
     s.sign[v] = phi[v] > 0 ? 1 : phi[v] < 0 ? -1 : 0;
     if (s.sign[v] == 0) s.zeros.push_back(int(v));
   }
   s.seg_start.push_back(0);
-  for (std::size_t f = 0; f < m.nf; ++f) add_phi_seed(m, phi, int(f), s);
+  for (std::size_t f = 0; f < m.nf(); ++f) add_phi_seed(m, phi, int(f), s);
   return s;
 }
 
@@ -49,8 +49,8 @@ namespace {
 /// interface-degree ≠ 2, on the boundary of S, or where the curve turns by more than 30°.
 void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector<Vec3>& curvature,
                          std::vector<char>& smooth) {
-  std::vector<std::array<int, 2>> neighbour(m.nv, {-1, -1});
-  std::vector<int> degree(m.nv, 0);
+  std::vector<std::array<int, 2>> neighbour(m.nv(), {-1, -1});
+  std::vector<int> degree(m.nv(), 0);
   for (auto e : mesh.edges()) {
     if (!mesh.interface(e)) continue;
     const auto h = mesh.halfedge_handle(e, 0);
@@ -61,12 +61,12 @@ void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector
     ++degree[b];
   }
   const double cos_max_turn = std::cos(std::numbers::pi / 6);
-  curvature.assign(m.nv, Vec3(0, 0, 0));
-  smooth.assign(m.nv, 0);
-  for (std::size_t v = 0; v < m.nv; ++v) {
+  curvature.assign(m.nv(), Vec3(0, 0, 0));
+  smooth.assign(m.nv(), 0);
+  for (std::size_t v = 0; v < m.nv(); ++v) {
     if (degree[v] != 2 || mesh.is_boundary(VertexHandle(int(v)))) continue;
-    const Vec3& x = m.points[v];
-    const Vec3 u = m.points[neighbour[v][0]] - x, w = m.points[neighbour[v][1]] - x;
+    const Vec3& x = m.point(int(v));
+    const Vec3 u = m.point(neighbour[v][0]) - x, w = m.point(neighbour[v][1]) - x;
     // The turn between the segments (x − u-end) and (w-end − x) has cosine −u·w / (|u||w|).
     if (-(u | w) < cos_max_turn * u.norm() * w.norm()) continue;
     smooth[v] = 1;
@@ -76,8 +76,11 @@ void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector
     const Vec3 centre = ((w * u.sqrnorm() - u * w.sqrnorm()) % uw) / (2 * uw2);  // circumcentre − x
     Vec3 k = centre / centre.sqrnorm();
     Vec3 normal(0, 0, 0);
-    for (int j = m.fan_start[v]; j < m.fan_start[v + 1]; ++j)
-      normal += (m.points[m.fan[j].a] - x) % (m.points[m.fan[j].b] - x);
+    const FanRange fan = m.fan(int(v));
+    for (int j = fan.begin; j < fan.end; ++j) {
+      const FanTriangle t = m.fan_triangle(j);
+      normal += (m.point(t.a) - x) % (m.point(t.b) - x);
+    }
     const double length = normal.norm();
     if (length > 0) {
       normal /= length;
@@ -97,23 +100,27 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved)
   const Vec3 zero(0, 0, 0);
   // An interface edge bends only when both its ends are smooth curve points.
   auto add_segment = [&](int a, int b) {
-    s.segments.emplace_back(m.points[a], m.points[b]);
+    s.segments.emplace_back(m.point(a), m.point(b));
     if (!curved) return;
     if (a != b && smooth[a] && smooth[b]) s.bends.emplace_back(curvature[a], curvature[b]);
     else s.bends.emplace_back(zero, zero);
   };
-  s.sign.assign(m.nv, 1);
-  for (std::size_t f = 0; f < m.nf; ++f)
-    if (mesh.inside(FaceHandle(int(f))))
-      for (int c = 0; c < 3; ++c) s.sign[m.corner_vertex[3 * f + c]] = -1;
-  std::vector<char> on_interface(m.nv, 0);
+  s.sign.assign(m.nv(), 1);
+  for (auto f : mesh.faces())
+    if (mesh.inside(f)) {
+      const auto h = mesh.halfedge_handle(f);
+      s.sign[std::size_t(mesh.from_vertex_handle(h).idx())] = -1;
+      s.sign[std::size_t(mesh.to_vertex_handle(h).idx())] = -1;
+      s.sign[std::size_t(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx())] = -1;
+    }
+  std::vector<char> on_interface(m.nv(), 0);
   for (auto e : mesh.edges()) {
     if (!mesh.interface(e)) continue;
     const auto h = mesh.halfedge_handle(e, 0);
     on_interface[mesh.from_vertex_handle(h).idx()] = 1;
     on_interface[mesh.to_vertex_handle(h).idx()] = 1;
   }
-  for (std::size_t v = 0; v < m.nv; ++v)
+  for (std::size_t v = 0; v < m.nv(); ++v)
     if (on_interface[v]) {
       s.sign[v] = 0;
       s.zeros.push_back(int(v));
