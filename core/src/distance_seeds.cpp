@@ -3,7 +3,12 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <numbers>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace bodyfit::distance_detail {
 
@@ -43,40 +48,70 @@ Seeds seeds_from_phi(const FlatMesh& m, const ScalarField& phi) {
 
 namespace {
 
+/// The interface's vertices (in index order) with their interface neighbours; `slot` maps a vertex
+/// to its place in `vertices`, −1 off the interface.
+struct InterfaceCurve {
+  struct End {
+    std::array<int, 2> neighbour{-1, -1};
+    int degree = 0;
+    bool smooth = false;
+    Vec3 curvature{0, 0, 0};
+  };
+  std::vector<int> vertices, slot;
+  std::vector<End> ends;
+};
+
+InterfaceCurve interface_curve(const SurfaceMesh& mesh) {
+  InterfaceCurve curve;
+  curve.slot.assign(mesh.n_vertices(), -1);
+  std::vector<std::array<int, 2>> edges;
+  for (auto e : mesh.edges())
+    if (mesh.interface(e)) {
+      const auto h = mesh.halfedge_handle(e, 0);
+      const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
+      edges.push_back({a, b});
+      for (int v : {a, b})
+        if (curve.slot[std::size_t(v)] < 0) {
+          curve.slot[std::size_t(v)] = 0;
+          curve.vertices.push_back(v);
+        }
+    }
+  std::sort(curve.vertices.begin(), curve.vertices.end());
+  for (std::size_t i = 0; i < curve.vertices.size(); ++i) curve.slot[std::size_t(curve.vertices[i])] = int(i);
+  curve.ends.resize(curve.vertices.size());
+  for (const auto& [a, b] : edges) {
+    auto& ea = curve.ends[std::size_t(curve.slot[std::size_t(a)])];
+    auto& eb = curve.ends[std::size_t(curve.slot[std::size_t(b)])];
+    if (ea.degree < 2) ea.neighbour[std::size_t(ea.degree)] = b;
+    if (eb.degree < 2) eb.neighbour[std::size_t(eb.degree)] = a;
+    ++ea.degree;
+    ++eb.degree;
+  }
+  return curve;
+}
+
 /// Curvature vector of the interface curve (towards the centre of the circle through a vertex and
 /// its two interface neighbours, projected on the tangent plane of S: the geodesic curvature) at
-/// each interface vertex where the curve is smooth. `smooth` is false at the vertices of
-/// interface-degree ≠ 2, on the boundary of S, or where the curve turns by more than 30°.
-void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector<Vec3>& curvature,
-                         std::vector<char>& smooth) {
-  std::vector<std::array<int, 2>> neighbour(m.nv(), {-1, -1});
-  std::vector<int> degree(m.nv(), 0);
-  for (auto e : mesh.edges()) {
-    if (!mesh.interface(e)) continue;
-    const auto h = mesh.halfedge_handle(e, 0);
-    const int a = mesh.from_vertex_handle(h).idx(), b = mesh.to_vertex_handle(h).idx();
-    if (degree[a] < 2) neighbour[a][degree[a]] = b;
-    if (degree[b] < 2) neighbour[b][degree[b]] = a;
-    ++degree[a];
-    ++degree[b];
-  }
+/// each interface vertex where the curve is smooth. Not smooth: the vertices of interface-degree
+/// ≠ 2, on the boundary of S, or where the curve turns by more than 30°.
+void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, InterfaceCurve& curve) {
   const double cos_max_turn = std::cos(std::numbers::pi / 6);
-  curvature.assign(m.nv(), Vec3(0, 0, 0));
-  smooth.assign(m.nv(), 0);
-  for (std::size_t v = 0; v < m.nv(); ++v) {
-    if (degree[v] != 2 || mesh.is_boundary(VertexHandle(int(v)))) continue;
-    const Vec3& x = m.point(int(v));
-    const Vec3 u = m.point(neighbour[v][0]) - x, w = m.point(neighbour[v][1]) - x;
+  for (std::size_t i = 0; i < curve.vertices.size(); ++i) {
+    const int v = curve.vertices[i];
+    auto& end = curve.ends[i];
+    if (end.degree != 2 || mesh.is_boundary(VertexHandle(v))) continue;
+    const Vec3& x = m.point(v);
+    const Vec3 u = m.point(end.neighbour[0]) - x, w = m.point(end.neighbour[1]) - x;
     // The turn between the segments (x − u-end) and (w-end − x) has cosine −u·w / (|u||w|).
     if (-(u | w) < cos_max_turn * u.norm() * w.norm()) continue;
-    smooth[v] = 1;
+    end.smooth = true;
     const Vec3 uw = u % w;
     const double uw2 = uw.sqrnorm();
     if (uw2 == 0) continue;  // collinear: straight
     const Vec3 centre = ((w * u.sqrnorm() - u * w.sqrnorm()) % uw) / (2 * uw2);  // circumcentre − x
     Vec3 k = centre / centre.sqrnorm();
     Vec3 normal(0, 0, 0);
-    const FanRange fan = m.fan(int(v));
+    const FanRange fan = m.fan(v);
     for (int j = fan.begin; j < fan.end; ++j) {
       const FanTriangle t = m.fan_triangle(j);
       normal += (m.point(t.a) - x) % (m.point(t.b) - x);
@@ -86,7 +121,7 @@ void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector
       normal /= length;
       k -= normal * (k | normal);
     }
-    curvature[v] = k;
+    end.curvature = k;
   }
 }
 
@@ -94,37 +129,32 @@ void interface_curvature(const SurfaceMesh& mesh, const FlatMesh& m, std::vector
 
 Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved) {
   Seeds s;
-  std::vector<Vec3> curvature;
-  std::vector<char> smooth;
-  if (curved) interface_curvature(mesh, m, curvature, smooth);
+  InterfaceCurve curve = interface_curve(mesh);
+  if (curved) interface_curvature(mesh, m, curve);
+  auto on_interface = [&](int v) { return curve.slot[std::size_t(v)] >= 0; };
   const Vec3 zero(0, 0, 0);
   // An interface edge bends only when both its ends are smooth curve points.
   auto add_segment = [&](int a, int b) {
     s.segments.emplace_back(m.point(a), m.point(b));
     if (!curved) return;
-    if (a != b && smooth[a] && smooth[b]) s.bends.emplace_back(curvature[a], curvature[b]);
+    const auto& ea = curve.ends[std::size_t(curve.slot[std::size_t(a)])];
+    const auto& eb = curve.ends[std::size_t(curve.slot[std::size_t(b)])];
+    if (a != b && ea.smooth && eb.smooth) s.bends.emplace_back(ea.curvature, eb.curvature);
     else s.bends.emplace_back(zero, zero);
   };
   s.sign.assign(m.nv(), 1);
-  for (auto f : mesh.faces())
-    if (mesh.inside(f)) {
-      const auto h = mesh.halfedge_handle(f);
-      s.sign[std::size_t(mesh.from_vertex_handle(h).idx())] = -1;
-      s.sign[std::size_t(mesh.to_vertex_handle(h).idx())] = -1;
-      s.sign[std::size_t(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)).idx())] = -1;
-    }
-  std::vector<char> on_interface(m.nv(), 0);
-  for (auto e : mesh.edges()) {
-    if (!mesh.interface(e)) continue;
-    const auto h = mesh.halfedge_handle(e, 0);
-    on_interface[mesh.from_vertex_handle(h).idx()] = 1;
-    on_interface[mesh.to_vertex_handle(h).idx()] = 1;
-  }
-  for (std::size_t v = 0; v < m.nv(); ++v)
-    if (on_interface[v]) {
-      s.sign[v] = 0;
-      s.zeros.push_back(int(v));
-    }
+  // −1 at the vertices of the region's faces; several faces may write the same −1 at once.
+  tbb::parallel_for(tbb::blocked_range<int>(0, int(mesh.n_faces()), 8192), [&](const tbb::blocked_range<int>& range) {
+    for (int f = range.begin(); f != range.end(); ++f)
+      if (mesh.inside(FaceHandle(f))) {
+        const auto h = mesh.halfedge_handle(FaceHandle(f));
+        for (auto v : {mesh.from_vertex_handle(h), mesh.to_vertex_handle(h),
+                       mesh.to_vertex_handle(mesh.next_halfedge_handle(h))})
+          std::atomic_ref<signed char>(s.sign[std::size_t(v.idx())]).store(-1, std::memory_order_relaxed);
+      }
+  });
+  for (int v : curve.vertices) s.sign[std::size_t(v)] = 0;
+  s.zeros = curve.vertices;
   s.seg_start.push_back(0);
   // A seed face has an interface edge or a corner on the interface: one of the faces around the
   // interface's vertices (in index order, as a pass over every face would find them).
@@ -141,7 +171,7 @@ Seeds seeds_from_region(const SurfaceMesh& mesh, const FlatMesh& m, bool curved)
       if (mesh.interface(mesh.edge_handle(h))) {
         add_segment(a, b);
         seed = true;
-      } else if (on_interface[a]) {
+      } else if (on_interface(a)) {
         add_segment(a, a);
         seed = true;
       }

@@ -1,5 +1,7 @@
 #include <bodyfit/geometry.hpp>
 
+#include "blocks.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -253,12 +255,16 @@ BoundingBox bounding_box(const SurfaceMesh& mesh) {
 }
 
 QualityStats quality_stats(const SurfaceMesh& mesh) {
+  // Each face's quality in parallel, then the statistics in index order (the mean to the last bit).
+  const std::vector<double> quality = terms(int(mesh.n_faces()), [&](int f) {
+    return mesh.status(FaceHandle(f)).deleted() ? -1.0 : face_quality(mesh, FaceHandle(f));
+  });
   QualityStats s;
   s.min = std::numeric_limits<double>::infinity();
   double sum = 0;
   std::size_t below = 0;
-  for (auto f : mesh.faces()) {
-    double q = face_quality(mesh, f);
+  for (double q : quality) {
+    if (q < 0) continue;  // deleted
     s.min = std::min(s.min, q);
     s.max = std::max(s.max, q);
     sum += q;
@@ -271,11 +277,7 @@ QualityStats quality_stats(const SurfaceMesh& mesh) {
   return s;
 }
 
-double mean_edge_length(const SurfaceMesh& mesh) {
-  double sum = 0;
-  for (auto e : mesh.edges()) sum += edge_length(mesh, e);  // as edge_length_stats, to the last bit
-  return mesh.n_edges() ? sum / double(mesh.n_edges()) : 0.0;
-}
+double mean_edge_length(const SurfaceMesh& mesh) { return edge_length_stats(mesh).mean; }
 
 double resolution_length(const SurfaceMesh& mesh) {
   double area = 0;
@@ -288,11 +290,15 @@ double resolution_length(const SurfaceMesh& mesh) {
 }
 
 EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
+  // Each length in parallel, then the statistics in index order (the mean to the last bit).
+  const std::vector<double> lengths = terms(int(mesh.n_edges()), [&](int e) {
+    return mesh.status(EdgeHandle(e)).deleted() ? -1.0 : edge_length(mesh, EdgeHandle(e));
+  });
   EdgeLengthStats s;
   s.min = std::numeric_limits<double>::infinity();
   double sum = 0, sum_sq = 0;
-  for (auto e : mesh.edges()) {
-    double l = edge_length(mesh, e);
+  for (double l : lengths) {
+    if (l < 0) continue;  // deleted
     s.min = std::min(s.min, l);
     s.max = std::max(s.max, l);
     sum += l;
@@ -306,23 +312,23 @@ EdgeLengthStats edge_length_stats(const SurfaceMesh& mesh) {
 }
 
 double total_area(const SurfaceMesh& mesh) {
-  double area = 0;
-  for (auto f : mesh.faces()) area += face_area(mesh, f);
-  return area;
+  return sum_in_order(int(mesh.n_faces()), [&](int f) {
+    return mesh.status(FaceHandle(f)).deleted() ? 0.0 : face_area(mesh, FaceHandle(f));
+  });
 }
 
 double region_area(const SurfaceMesh& mesh, int region) {
-  double area = 0;
-  for (auto f : mesh.faces())
-    if (mesh.region(f) == region) area += face_area(mesh, f);
-  return area;
+  return sum_in_order(int(mesh.n_faces()), [&](int f) {
+    const FaceHandle face(f);
+    return mesh.region(face) == region && !mesh.status(face).deleted() ? face_area(mesh, face) : 0.0;
+  });
 }
 
 double interface_length(const SurfaceMesh& mesh) {
-  double length = 0;
-  for (auto e : mesh.edges())
-    if (mesh.interface(e)) length += edge_length(mesh, e);
-  return length;
+  return sum_in_order(int(mesh.n_edges()), [&](int e) {
+    const EdgeHandle edge(e);
+    return mesh.interface(edge) && !mesh.status(edge).deleted() ? edge_length(mesh, edge) : 0.0;
+  });
 }
 
 namespace {
@@ -400,8 +406,13 @@ int flood_components(const SurfaceMesh& mesh, Keep keep, std::vector<int>* label
   std::vector<int> label(mesh.n_faces(), -1);
   int n = 0;
   std::vector<FaceHandle> stack;
-  for (auto seed : mesh.faces()) {
-    if (label[seed.idx()] >= 0 || !keep(seed)) continue;
+  // The faces kept, found in parallel: a region is often a small part of the mesh.
+  const auto kept = collect<FaceHandle>(int(mesh.n_faces()), [&](int i, FaceHandle& f) {
+    f = FaceHandle(i);
+    return !mesh.status(f).deleted() && keep(f);
+  });
+  for (auto seed : kept) {
+    if (label[seed.idx()] >= 0) continue;
     label[seed.idx()] = n;
     stack.push_back(seed);
     while (!stack.empty()) {

@@ -3,11 +3,15 @@
 #include <bodyfit/error.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/remesh.hpp>
+
+#include "blocks.hpp"
 
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -190,6 +194,14 @@ void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, Scala
   }
 }
 
+/// The vertices where `value` is exactly 0, in index order.
+std::vector<VertexHandle> zeros(const SurfaceMesh& mesh, const ScalarField& value) {
+  return collect<VertexHandle>(int(mesh.n_vertices()), [&](int i, VertexHandle& v) {
+    v = VertexHandle(i);
+    return value[std::size_t(i)] == 0 && !mesh.status(v).deleted();
+  });
+}
+
 /// Where the input φ is exactly 0 at a vertex around which the cut would not be a simple curve
 /// (a saddle: inside parts meeting at the vertex), put the vertex on the outside: φ = δ > 0, the
 /// geometric mean of |φ| over its negative neighbours, so the new crossings sit at comparable
@@ -197,9 +209,8 @@ void snap(const SurfaceMesh& mesh, const std::vector<EdgeHandle>& crossed, Scala
 /// (each vertex moves at most once, since only vertices with φ = 0 can be spoiled).
 std::vector<VertexHandle> separate_pinches(const SurfaceMesh& mesh, ScalarField& value, DiscretizeReport& report) {
   std::vector<VertexHandle> work, separated;
-  for (auto v : mesh.vertices())
-    if (value[v.idx()] == 0 && !acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v)))
-      work.push_back(v);
+  for (auto v : zeros(mesh, value))
+    if (!acceptable_degree(mesh, v, predicted_interface_degree(mesh, value, v))) work.push_back(v);
   std::reverse(work.begin(), work.end());  // pop in index order
   while (!work.empty()) {
     auto v = work.back();
@@ -418,9 +429,10 @@ std::size_t remove_detached(SurfaceMesh& mesh, ScalarField& value, std::span<con
 std::vector<EdgeHandle> crossed_edges(SurfaceMesh& mesh, ScalarField& value, const DiscretizeOptions& options,
                                       bool find_parts, std::vector<VertexHandle>& may_be_zero,
                                       DiscretizeReport& report) {
-  std::vector<EdgeHandle> crossed;
-  for (auto e : mesh.edges())
-    if (crossed_edge(mesh, value, e)) crossed.push_back(e);
+  std::vector<EdgeHandle> crossed = collect<EdgeHandle>(int(mesh.n_edges()), [&](int i, EdgeHandle& e) {
+    e = EdgeHandle(i);
+    return !mesh.status(e).deleted() && crossed_edge(mesh, value, e);
+  });
   if (find_parts)
     for (auto e : crossed)
       for (int side = 0; side < 2; ++side) may_be_zero.push_back(mesh.to_vertex_handle(mesh.halfedge_handle(e, side)));
@@ -529,47 +541,48 @@ void split_crossed_edges(SurfaceMesh& mesh, ScalarField& value, const std::vecto
 
 /// Every face lies on one side once the crossed edges are split: inside when a vertex is negative.
 void label_faces(SurfaceMesh& mesh, const ScalarField& value) {
-  for (auto f : mesh.faces()) {
+  for_each_index(int(mesh.n_faces()), [&](int i) {
+    const FaceHandle f(i);
+    if (mesh.status(f).deleted()) return;
     auto h = mesh.halfedge_handle(f);
     auto h1 = mesh.next_halfedge_handle(h);
     bool inside = value[mesh.to_vertex_handle(h).idx()] < 0 || value[mesh.to_vertex_handle(h1).idx()] < 0 ||
                   value[mesh.from_vertex_handle(h).idx()] < 0;
     mesh.region(f) = inside ? kInside : kOutside;
-  }
+  });
 }
 
 /// The interface: exactly the edges between faces of different labels (as
 /// update_interface_from_regions), counting interface edges per vertex as a self-check.
 void tag_interface(SurfaceMesh& mesh, DiscretizeReport& report) {
+  // Each edge's tags set in parallel; the interface's edges gathered in index order.
+  const auto interface = collect<EdgeHandle>(int(mesh.n_edges()), [&](int i, EdgeHandle& e) {
+    e = EdgeHandle(i);
+    if (mesh.status(e).deleted()) return false;
+    auto f0 = mesh.face_handle(mesh.halfedge_handle(e, 0)), f1 = mesh.face_handle(mesh.halfedge_handle(e, 1));
+    const bool is_interface = f0.is_valid() && f1.is_valid() && mesh.region(f0) != mesh.region(f1);
+    mesh.interface(e) = is_interface;
+    if (is_interface) mesh.edge_ref(e) = kInterfaceRef;
+    else if (mesh.edge_ref(e) == kInterfaceRef) mesh.edge_ref(e) = 0;
+    return is_interface;
+  });
   std::vector<VertexHandle> interface_vertices;
   std::vector<unsigned char> degree;
-  for (auto e : mesh.edges()) {
-    auto h0 = mesh.halfedge_handle(e, 0), h1 = mesh.halfedge_handle(e, 1);
-    auto f0 = mesh.face_handle(h0), f1 = mesh.face_handle(h1);
-    bool is_interface = f0.is_valid() && f1.is_valid() && mesh.region(f0) != mesh.region(f1);
-    mesh.interface(e) = is_interface;
-    if (is_interface) {
-      mesh.edge_ref(e) = kInterfaceRef;
-      ++report.interface_edges;
-      if (degree.empty()) degree.assign(mesh.n_vertices(), 0);
-      for (auto v : {mesh.to_vertex_handle(h0), mesh.to_vertex_handle(h1)})
-        if (degree[v.idx()]++ == 0) interface_vertices.push_back(v);
-    } else if (mesh.edge_ref(e) == kInterfaceRef) {
-      mesh.edge_ref(e) = 0;
+  if (!interface.empty()) degree.assign(mesh.n_vertices(), 0);
+  report.interface_edges += interface.size();
+  for (auto e : interface)
+    for (int side = 0; side < 2; ++side) {
+      const auto v = mesh.to_vertex_handle(mesh.halfedge_handle(e, side));
+      if (degree[v.idx()]++ == 0) interface_vertices.push_back(v);
     }
-  }
   for (auto v : interface_vertices)
     if (!acceptable_degree(mesh, v, degree[v.idx()])) ++report.pinched_vertices;
 }
 
 /// Garbage-collect the elements the snaps and the separations deleted, if any.
 void collect_deleted(SurfaceMesh& mesh) {
-  bool has_deleted = false;
-  for (std::size_t i = 0; i < mesh.n_faces() && !has_deleted; ++i) has_deleted = mesh.status(FaceHandle(int(i))).deleted();
-  for (std::size_t i = 0; i < mesh.n_edges() && !has_deleted; ++i) has_deleted = mesh.status(EdgeHandle(int(i))).deleted();
-  for (std::size_t i = 0; i < mesh.n_vertices() && !has_deleted; ++i)
-    has_deleted = mesh.status(VertexHandle(int(i))).deleted();
-  if (has_deleted) mesh.garbage_collection();
+  if (has_deleted_elements(mesh))
+    mesh.garbage_collection();
 }
 
 }  // namespace
@@ -586,12 +599,15 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
   const double h_input = options.speck_area > 0 || !options.grown_from.empty() ? edge_length_stats(mesh).mean : 0;
   // Vertices that may end up on the level set: the input's zeros and the ends of crossed edges
   // (snapped); the cut adds its new vertices. The faces around them are the speck search's seeds.
-  std::vector<VertexHandle> may_be_zero;
-  for (auto v : mesh.vertices()) {
-    if (!std::isfinite(value[v.idx()]))
-      throw InputError("discretize: the level set is not finite at vertex " + std::to_string(v.idx()));
-    if (value[v.idx()] == 0) may_be_zero.push_back(v);
-  }
+  const int not_finite = reduce(
+      int(mesh.n_vertices()), std::numeric_limits<int>::max(),
+      [&](int v, int& first) {
+        if (first > v && !std::isfinite(value[std::size_t(v)]) && !mesh.status(VertexHandle(v)).deleted()) first = v;
+      },
+      [](int& total, int part) { total = std::min(total, part); });
+  if (not_finite != std::numeric_limits<int>::max())
+    throw InputError("discretize: the level set is not finite at vertex " + std::to_string(not_finite));
+  std::vector<VertexHandle> may_be_zero = zeros(mesh, value);
 
   const bool find_parts = options.speck_area > 0 || !options.grown_from.empty();
   const std::vector<EdgeHandle> crossed = crossed_edges(mesh, value, options, find_parts, may_be_zero, report);
@@ -622,8 +638,11 @@ DiscretizeReport discretize(SurfaceMesh& mesh, const ScalarField& phi, const Dis
     if (options.speck_area > 0)
       report.removed_specks = remove_specks(mesh, value, options.speck_area * h_input * h_input, std::move(seeds));
   }
-  for (auto f : mesh.faces()) report.inside_faces += mesh.region(f) == kInside;
-  for (auto v : mesh.vertices()) mesh.phi(v) = value[v.idx()];
+  report.inside_faces = reduce(
+      int(mesh.n_faces()), std::size_t(0),
+      [&](int f, std::size_t& count) { count += !mesh.status(FaceHandle(f)).deleted() && mesh.region(FaceHandle(f)) == kInside; },
+      [](std::size_t& total, std::size_t part) { total += part; });
+  for_each_index(int(mesh.n_vertices()), [&](int v) { mesh.phi(VertexHandle(v)) = value[std::size_t(v)]; });
   tag_interface(mesh, report);
   collect_deleted(mesh);
   return report;

@@ -101,14 +101,18 @@ void Remesher::split_long_edges() {
   // No size is below hmin, so edges of hmin covering the surface bound what splitting can make (4×
   // for the gradation and the rounds' leftovers): beyond, splits no longer bring triangles to size
   // (a needle to a far vertex, split along its length into ever more needles) and would not end.
-  const double area = total_area(m_);
-  const double bound = 4 * faces_for_edge_length(area, hmin_) + 2.0 * double(m_.n_faces());
+  // The surface's area, a pass over every face, only once there is something to split.
+  double area = -1, bound = 0;
   while (true) {
     ranked_.clear();
     for (auto e : edges_)
       if (!m_.status(e).deleted())
         if (double r = ratio(e); r > kSplitRatio) ranked_.emplace_back(r, e);
     if (ranked_.empty()) break;
+    if (area < 0) {
+      area = total_area(m_);
+      bound = 4 * faces_for_edge_length(area, hmin_) + 2.0 * double(m_.n_faces());
+    }
     // Longest first; ties by index, so the order never depends on how the list was gathered.
     std::sort(ranked_.begin(), ranked_.end(), [](const auto& x, const auto& y) {
       return x.first != y.first ? x.first > y.first : x.second.idx() < y.second.idx();
@@ -382,11 +386,8 @@ const char* to_string(RemeshStop stop) {
 }
 
 RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions& options) {
-  bool garbage = false;
-  for (auto v : mesh.all_vertices()) garbage |= mesh.status(v).deleted();
-  for (auto e : mesh.all_edges()) garbage |= mesh.status(e).deleted();
-  for (auto f : mesh.all_faces()) garbage |= mesh.status(f).deleted();
-  if (garbage) collect_garbage(mesh);
+  if (has_deleted_elements(mesh))
+    collect_garbage(mesh);
   remesh_detail::Remesher remesher(mesh, options);
   return remesher.run();
 }

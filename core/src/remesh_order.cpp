@@ -10,6 +10,8 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/remesh.hpp>
 
+#include "blocks.hpp"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -117,6 +119,16 @@ double spatial_disorder(const SurfaceMesh& mesh) {
   // A hole will be filled by the last vertex: about six far edges once compacted.
   const std::size_t holes = mesh.n_vertices() - live_v;
   return total_live > 0 ? double(total_far + 6 * holes) / double(total_live) : 0.0;
+}
+
+bool has_deleted_elements(const SurfaceMesh& mesh) {
+  auto any = [](int n, auto&& deleted) {
+    return reduce(n, 0, [&](int i, int& found) { found = found || deleted(i); },
+                  [](int& total, int part) { total = total || part; }) != 0;
+  };
+  return any(int(mesh.n_faces()), [&](int i) { return mesh.status(FaceHandle(i)).deleted(); }) ||
+         any(int(mesh.n_edges()), [&](int i) { return mesh.status(EdgeHandle(i)).deleted(); }) ||
+         any(int(mesh.n_vertices()), [&](int i) { return mesh.status(VertexHandle(i)).deleted(); });
 }
 
 void collect_garbage(SurfaceMesh& mesh) {

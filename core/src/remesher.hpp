@@ -9,6 +9,8 @@
 //                        under a cap) and the final degenerate-triangle report.
 #include <bodyfit/remesh.hpp>
 
+#include "blocks.hpp"
+
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/projection.hpp>
 
@@ -128,26 +130,6 @@ inline bool keeps_facing(const Tri& old_tri, const Tri& new_tri, const Vec3& sur
 // passes' (a collapse keeps every new triangle above min(kAcceptQuality, the worst it replaces); a
 // flip improves a pair below kFlipBelow) or the sliver repair's (any strict improvement).
 enum class Rule { Pass, Repair };
-
-// The results of f(i) for i in [0, n) that f sets (f returns false for none), in index order:
-// gathered in parallel by fixed blocks and concatenated, so the list never depends on the threads.
-template <class T, class F>
-std::vector<T> collect(int n, F&& f) {
-  constexpr int kBlock = 8192;
-  const int blocks = (n + kBlock - 1) / kBlock;
-  std::vector<std::vector<T>> parts(std::size_t(std::max(blocks, 0)));
-  tbb::parallel_for(0, blocks, [&](int b) {
-    T item;
-    for (int i = b * kBlock; i < std::min(n, (b + 1) * kBlock); ++i)
-      if (f(i, item)) parts[std::size_t(b)].push_back(item);
-  });
-  std::vector<T> all;
-  std::size_t total = 0;
-  for (const auto& p : parts) total += p.size();
-  all.reserve(total);
-  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
-  return all;
-}
 
 class Remesher {
  public:

@@ -109,4 +109,7 @@ double spatial_disorder(const SurfaceMesh& mesh);
 /// updated, so the cost follows the number of holes, not the size of the mesh.
 void collect_garbage(SurfaceMesh& mesh);
 
+/// Whether any vertex, edge or face of `mesh` is deleted (a parallel sweep over the status flags).
+bool has_deleted_elements(const SurfaceMesh& mesh);
+
 }  // namespace bodyfit
