@@ -10,6 +10,7 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/projection.hpp>
 
 #include "test_support.hpp"
 
@@ -179,4 +180,84 @@ TEST_CASE("a model that smooths over S is given d on the whole surface: the whol
     CHECK(banded.result.records[k].interface_length == whole.result.records[k].interface_length);
   }
   CHECK(banded.largest_d == whole.largest_d);
+}
+
+namespace {
+
+/// V = n_Σ; records, for each banded state's compute, whether band_vertices() is d's band and its
+/// ring, and whether surface_normals() holds S's smooth normal there (bit for bit) and 0 beyond.
+class BandProbe final : public VelocityModel {
+ public:
+  explicit BandProbe(const ReferenceSurface& surface) : surface_(surface) {}
+  std::string_view name() const override { return "band probe"; }
+  void configure(Parameters&) override {}
+  VelocityField compute(const StepContext& context) override {
+    const SurfaceMesh& mesh = context.mesh();
+    const ScalarField& d = context.distance();
+    const std::span<const int> band = context.band_vertices();
+    if (context.active_vertices().empty() && !band.empty()) {
+      ++banded_states;
+      double width = 0;
+      for (double value : d) width = std::max(width, std::abs(value));
+      std::vector<char> expected(mesh.n_vertices(), 0);
+      for (auto v : mesh.vertices())
+        if (std::abs(d[v.idx()]) < width) {
+          expected[v.idx()] = 1;
+          for (auto w : mesh.vv_range(v)) expected[w.idx()] = 1;
+        }
+      std::vector<int> listed;
+      for (std::size_t v = 0; v < expected.size(); ++v)
+        if (expected[v]) listed.push_back(int(v));
+      band_is_d_band = band_is_d_band && std::equal(band.begin(), band.end(), listed.begin(), listed.end());
+      smaller_than_mesh = smaller_than_mesh && band.size() < mesh.n_vertices() / 2;
+      const VectorField& normals = context.surface_normals();
+      std::vector<char> in_band(mesh.n_vertices(), 0);
+      for (int v : band) {
+        in_band[std::size_t(v)] = 1;
+        normals_exact = normals_exact && normals[std::size_t(v)] == surface_.smooth_normal(mesh.point(VertexHandle(v)));
+      }
+      for (auto v : mesh.vertices())
+        if (!in_band[v.idx()]) zero_beyond = zero_beyond && normals[v.idx()] == Vec3(0, 0, 0);
+    }
+    VectorField velocity = context.conormal();
+    return VelocityField::tangential(std::move(velocity));
+  }
+  int banded_states = 0;
+  bool band_is_d_band = true, smaller_than_mesh = true, normals_exact = true, zero_beyond = true;
+
+ private:
+  const ReferenceSurface& surface_;
+};
+
+}  // namespace
+
+TEST_CASE("in a banded state, band_vertices() is d's band and its ring, and surface_normals() S's normals there") {
+  CaseSetup setup = setup_case(parse_case(toml::parse(R"(
+[surface]
+generator = "terrain"
+extent = 40000.0
+h = 500.0
+seed = 7
+max_height = 1500.0
+feature_size = 3000.0
+[region]
+shape = "disks"
+centers = [[20000.0, 20000.0]]
+radii = [2000.0]
+[model]
+name = "conormal"
+[time]
+dt = 300.0
+iterations = 4
+)")));
+  auto surface = std::make_shared<ReferenceSurface>(setup.mesh);
+  setup.options.remesh.reference = surface;
+  setup.options.narrow_band = true;
+  BandProbe probe(*surface);
+  evolve(setup.mesh, probe, setup.options, {}, EvolutionHooks::quiet());
+  CHECK(probe.banded_states >= 3);
+  CHECK(probe.band_is_d_band);
+  CHECK(probe.smaller_than_mesh);
+  CHECK(probe.normals_exact);  // each vertex's own search: the same normal whichever are asked for
+  CHECK(probe.zero_beyond);
 }

@@ -24,6 +24,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <optional>
 #include <fstream>
 #include <sstream>
 
@@ -270,6 +271,49 @@ TEST_CASE("narrow-band sub-steps: the whole-surface computation's front and arri
   CHECK(std::abs(region_area(band.mesh, kInside) - area) <= 1e-9 * area);
   CHECK(interface_hausdorff(band.mesh, whole.mesh) <= 1e-6 * h);
   // The arrival raster: the band visits only the cells near the front, with the same result.
+  const HeightGrid a = read_raw_grid(dir_band.path() / "arrival_time.asc");
+  const HeightGrid b = read_raw_grid(dir_whole.path() / "arrival_time.asc");
+  REQUIRE(a.heights.size() == b.heights.size());
+  std::size_t reached = 0, differ = 0;
+  for (std::size_t i = 0; i < a.heights.size(); ++i) {
+    reached += a.heights[i] != a.nodata;
+    differ += std::abs(a.heights[i] - b.heights[i]) > 1e-6;
+  }
+  CHECK(reached > 100);
+  CHECK(differ == 0);
+}
+
+TEST_CASE("the fire near its front (the default) gives the front of landscape_statistics, without its landscape metrics") {
+  // d in a band of the front against d on the whole surface: the same rates where the front goes.
+  const double h = 20;
+  const HeightGrid grid = bumpy_ground(h, 60);
+  const std::string wind = "[wind]\ntype = 'uniform'\nvelocity = [4.0, 2.0]\n";
+  test::TempDir dir_band("fire_near"), dir_whole("fire_landscape");
+  FireRun near = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, wind, 120, 3, dir_band.path(), 0.05, 1.0);
+  FireRun landscape = burn(make_terrain_from_grid(grid, h), {{600, 650, 120}}, "landscape_statistics = true\n" + wind, 120,
+                           3, dir_whole.path(), 0.05, 1.0);
+  REQUIRE(near.result.records.size() == 3);
+  REQUIRE(landscape.result.records.size() == 3);
+  auto metric = [](const IterationRecord& r, const std::string& name) -> std::optional<double> {
+    for (const auto& [key, value] : r.metrics)
+      if (key == name) return value;
+    return std::nullopt;
+  };
+  for (std::size_t k = 0; k < 3; ++k) {
+    CAPTURE(k);
+    const IterationRecord &a = near.result.records[k], &b = landscape.result.records[k];
+    CHECK(a.substeps == b.substeps);
+    CHECK(a.area == doctest::Approx(b.area).epsilon(1e-9));
+    for (const char* name : {"ros_min", "ros_mean", "ros_max"}) {
+      REQUIRE(metric(a, name));
+      CHECK(*metric(a, name) == doctest::Approx(*metric(b, name)).epsilon(1e-9));
+    }
+    CHECK(!metric(a, "ros_all_mean"));
+    CHECK(!metric(a, "ros_all_max"));
+    REQUIRE(metric(b, "ros_all_max"));
+    CHECK(*metric(b, "ros_all_max") >= *metric(b, "ros_max"));
+  }
+  CHECK(interface_hausdorff(near.mesh, landscape.mesh) <= 1e-6 * h);
   const HeightGrid a = read_raw_grid(dir_band.path() / "arrival_time.asc");
   const HeightGrid b = read_raw_grid(dir_whole.path() / "arrival_time.asc");
   REQUIRE(a.heights.size() == b.heights.size());

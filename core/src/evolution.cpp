@@ -3,6 +3,7 @@
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 
+#include "band_advector.hpp"
 #include "step_state.hpp"
 
 #include <fmt/format.h>
@@ -110,17 +111,6 @@ double longest_edge(const SurfaceMesh& mesh) {
         return longest;
       },
       [](double a, double b) { return std::max(a, b); });
-}
-
-/// The faces with a corner among `vertices`, each once, in index order.
-std::vector<int> faces_around(const SurfaceMesh& mesh, std::span<const int> vertices) {
-  std::vector<char> seen(mesh.n_faces(), 0);
-  std::vector<int> faces;
-  for (int v : vertices)
-    for (auto f : mesh.vf_range(VertexHandle(v)))
-      if (!seen[f.idx()]) seen[f.idx()] = 1, faces.push_back(f.idx());
-  std::sort(faces.begin(), faces.end());
-  return faces;
 }
 
 /// What step 2 (d, V, advection, sub-steps) hands to the cut.
@@ -272,10 +262,13 @@ class Evolution {
       ensure_band(need);
       band_width_ = next_band_width(need);
     }
-    Advector advector(mesh_);
+    // In a band (without composition) the sub-steps' Advector is built on the band's faces only.
+    std::optional<Advector> whole;
+    if (!options_.narrow_band || options_.compose_substeps) whole.emplace(mesh_);
+    BandAdvector band_advector(mesh_);
     StepGeometry geometry;
     ScalarField phi = distance_;
-    FrontSubsteps f = front_substeps(phi, advector);
+    FrontSubsteps f = front_substeps(phi, whole ? &*whole : nullptr);
     step.ms.distance += clock.lap_ms();
     VectorField velocity;
     while (step.done < dt) {
@@ -291,7 +284,7 @@ class Evolution {
         velocity = first_velocity(step, dt, attempt, clock, &geometry);
         if (version != distance_version_) {  // d^n measured again on the whole surface
           phi = distance_;
-          f = front_substeps(phi, advector);
+          f = front_substeps(phi, whole ? &*whole : nullptr);
         }
       } else {
         const StepContext context = context_for(mesh_, phi, n_, t_ + step.done, remaining, active, &geometry);
@@ -305,7 +298,7 @@ class Evolution {
       for (int v : f.band)
         if (std::abs(phi[v]) <= f.traced_width) f.traced.push_back(v);
       const double sub = substep_length(velocity, f.traced, remaining, step.substeps);
-      advect_front(f, advector, phi, velocity, sub, remaining, dt, attempt, step);
+      advect_front(f, whole ? &*whole : nullptr, band_advector, phi, velocity, sub, remaining, dt, attempt, step);
       step.ms.advect += clock.lap_ms();
     }
     step.phi_next = std::move(phi);
@@ -313,7 +306,7 @@ class Evolution {
   }
 
   /// The sub-steps' widths and first band on T^n (and the composition's start at φ^n).
-  FrontSubsteps front_substeps(const ScalarField& phi, Advector& advector) const {
+  FrontSubsteps front_substeps(const ScalarField& phi, Advector* whole) const {
     FrontSubsteps f;
     f.in_band = options_.narrow_band;
     f.compose = options_.compose_substeps;
@@ -325,7 +318,7 @@ class Evolution {
     f.band = within(phi, f.width);
     if (f.in_band) f.next = phi;
     if (f.compose) {
-      advector.start_composition(phi);
+      whole->start_composition(phi);
       if (!f.in_band) {
         f.everything.resize(mesh_.n_vertices());
         std::iota(f.everything.begin(), f.everything.end(), 0);
@@ -354,16 +347,24 @@ class Evolution {
 
   /// One sub-step of `sub` advecting φ: the traced vertices in the band; or on the whole surface,
   /// composed back to T^n or not.
-  void advect_front(FrontSubsteps& f, Advector& advector, ScalarField& phi, const VectorField& velocity, double sub,
-                    double remaining, double dt, int attempt, LevelSetStep& step) {
+  void advect_front(FrontSubsteps& f, Advector* whole, BandAdvector& band_advector, ScalarField& phi,
+                    const VectorField& velocity, double sub, double remaining, double dt, int attempt,
+                    LevelSetStep& step) {
     if (!f.in_band && !f.compose) {
-      phi = advect_substep(advector, phi, velocity, sub, remaining, dt, attempt, step);
+      phi = advect_substep(*whole, phi, velocity, sub, remaining, dt, attempt, step);
       return;
     }
     const AdvectionOptions& advection = options_.advection;
     AdvectionReport report;
     if (!f.in_band) f.next = phi;  // as in the band: only the vertices the front can reach are traced
     const std::vector<int>& known = f.in_band ? f.band : f.everything;  // where V is known
+    // Built around the band as far as two more sub-steps may take it (rings counted as 3/4 of a mean
+    // edge), built again when the band gets beyond it.
+    auto covering = [&]() -> Advector& {
+      const double rings = std::ceil((f.width + 2 * options_.max_cfl * cfl_length()) / (0.75 * cfl_length())) + 2;
+      return band_advector.covering(known, int(std::min(rings, double(mesh_.n_vertices()))));
+    };
+    Advector& advector = whole ? *whole : covering();
     if (f.compose)
       advector.advect_band_composed(phi, velocity, sub, f.traced, known, f.next, advection, &report);
     else

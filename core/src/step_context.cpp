@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
@@ -16,22 +17,23 @@ namespace bodyfit {
 
 namespace {
 
-/// S's smooth normal at every vertex. Fixed blocks, each searching from its previous vertex's
-/// triangle (neighbours in index order are near each other): the same result for any thread count.
-VectorField smooth_normals(const SurfaceMesh& mesh, const ReferenceSurface& surface) {
-  VectorField normals(mesh.n_vertices(), Vec3(0, 0, 0));
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, mesh.n_vertices(), 512),
-      [&](const tbb::blocked_range<std::size_t>& block) {
-        int hint = -1;
-        for (std::size_t v = block.begin(); v < block.end(); ++v) {
-          const SurfacePoint q = surface.closest(mesh.point(VertexHandle(int(v))), hint);
-          hint = q.face;
-          normals[v] = surface.smooth_normal(q);
-        }
-      },
-      tbb::simple_partitioner());
-  return normals;
+/// S's smooth normal at the vertices `where` that are not `known` yet (then known). Each is
+/// found on its own, without a hint from a neighbour, so a normal is the same whichever vertices
+/// are asked for together: a band gives the whole surface's values.
+void fill_smooth_normals(const SurfaceMesh& mesh, const ReferenceSurface& surface, std::span<const int> where,
+                         VectorField& normals, std::vector<char>& known) {
+  if (normals.size() != mesh.n_vertices()) {
+    normals.assign(mesh.n_vertices(), Vec3(0, 0, 0));
+    known.assign(mesh.n_vertices(), 0);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, where.size(), 256), [&](const tbb::blocked_range<std::size_t>& block) {
+    for (std::size_t i = block.begin(); i < block.end(); ++i) {
+      const auto v = std::size_t(where[i]);
+      if (known[v]) continue;
+      normals[v] = surface.smooth_normal(surface.closest(mesh.point(VertexHandle(int(v)))));
+      known[v] = 1;
+    }
+  });
 }
 
 }  // namespace
@@ -43,7 +45,9 @@ struct StepContext::Impl {
   mutable std::mutex mutex;
   mutable std::optional<double> mesh_size;
   mutable std::optional<std::vector<double>> face_areas;
-  mutable std::optional<VectorField> face_normals, vertex_normals, surface_normals, conormal;
+  mutable std::optional<VectorField> face_normals, vertex_normals, conormal;
+  mutable StepGeometry own_geometry;  // S's normals when the context shares none
+  mutable std::optional<std::vector<int>> near_front;
   mutable std::optional<Eigen::SparseMatrix<double>> mass, stiffness;
   mutable std::optional<std::vector<double>> lumped_mass;
   mutable std::optional<ScalarField> front_curvature;
@@ -64,15 +68,40 @@ struct StepContext::Impl {
     std::lock_guard lock(state.geometry->mutex);  // the step's contexts share one copy
     return compute(state.geometry->vertex_normals);
   }
+  /// Where the driver reads V: a sub-step's active vertices; in a banded state, the band's
+  /// vertices and their ring (d is flat beyond, n_Σ 0); empty when d is whole (every vertex).
+  std::span<const int> where_velocity_is_read() const {
+    if (!state.active.empty()) return state.active;
+    if (!std::isfinite(state.distance_width)) return {};
+    if (!near_front) {
+      const SurfaceMesh& m = mesh();
+      const ScalarField& d = *state.distance;
+      std::vector<char> near(m.n_vertices(), 0);
+      for (auto v : m.vertices())
+        if (std::abs(d[v.idx()]) < state.distance_width) {
+          near[v.idx()] = 1;
+          for (auto w : m.vv_range(v)) near[w.idx()] = 1;
+        }
+      std::vector<int> where;
+      for (std::size_t v = 0; v < near.size(); ++v)
+        if (near[v]) where.push_back(int(v));
+      near_front = std::move(where);
+    }
+    return *near_front;
+  }
   const VectorField& surface_normals_locked() const {
     if (!state.surface) return vertex_normals_locked();
-    auto compute = [&](std::optional<VectorField>& cache) -> const VectorField& {
-      if (!cache) cache = smooth_normals(mesh(), *state.surface);
-      return *cache;
-    };
-    if (!state.geometry) return compute(surface_normals);
-    std::lock_guard lock(state.geometry->mutex);
-    return compute(state.geometry->surface_normals);
+    std::span<const int> where = where_velocity_is_read();
+    std::vector<int> every;
+    if (where.empty()) {
+      every.resize(mesh().n_vertices());
+      std::iota(every.begin(), every.end(), 0);
+      where = every;
+    }
+    StepGeometry& g = state.geometry ? *state.geometry : own_geometry;
+    std::lock_guard lock(g.mutex);  // the step's contexts share one copy
+    fill_smooth_normals(mesh(), *state.surface, where, g.surface_normals, g.surface_known);
+    return g.surface_normals;
   }
   void couples_every_vertex() const {
     if (state.whole_surface_used) *state.whole_surface_used = true;
@@ -171,6 +200,11 @@ const VectorField& StepContext::surface_normals() const {
   return impl_->surface_normals_locked();
 }
 
+std::span<const int> StepContext::band_vertices() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->where_velocity_is_read();
+}
+
 const VectorField& StepContext::conormal() const {
   std::lock_guard lock(impl_->mutex);
   if (!impl_->conormal) {
@@ -187,18 +221,8 @@ const VectorField& StepContext::conormal() const {
     if (active.empty() && std::isfinite(width)) {
       // d banded: beyond the band and its ring every face is flat (±width), n_Σ is 0 there. The
       // band's vertices and their ring get the whole-surface values, bit for bit.
-      const SurfaceMesh& m = mesh();
-      const ScalarField& d = distance();
-      std::vector<char> near(m.n_vertices(), 0);
-      for (auto v : m.vertices())
-        if (std::abs(d[v.idx()]) < width) {
-          near[v.idx()] = 1;
-          for (auto w : m.vv_range(v)) near[w.idx()] = 1;
-        }
-      std::vector<int> where;
-      for (std::size_t v = 0; v < near.size(); ++v)
-        if (near[v]) where.push_back(int(v));
-      n = bodyfit::vertex_gradients(m, d, where);
+      const std::span<const int> where = impl_->where_velocity_is_read();
+      n = bodyfit::vertex_gradients(mesh(), distance(), where);
       for (int v : where) n[v] = unit(n[v]);
     } else if (active.empty()) {
       n = bodyfit::vertex_gradients(mesh(), distance());

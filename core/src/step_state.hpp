@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <span>
+#include <vector>
 
 namespace bodyfit {
 
@@ -15,7 +16,9 @@ namespace bodyfit {
 struct StepGeometry {
   std::mutex mutex;
   std::optional<VectorField> vertex_normals;
-  std::optional<VectorField> surface_normals;
+  /// S's normals, filled where a context of the step needed them (surface_known).
+  VectorField surface_normals;
+  std::vector<char> surface_known;
 };
 
 struct StepState {

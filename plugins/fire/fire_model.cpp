@@ -126,6 +126,12 @@ class FireModel final : public VelocityModel {
                               "principle); normal: V = R n_Σ as in the paper. The same front as the steps shrink; "
                               "huygens is closer at a given step")
             .fallback("huygens"),
+        ParameterDecl::boolean("landscape_statistics",
+                               "R at every vertex of the landscape (the rate_of_spread field, the metrics "
+                               "ros_all_mean and ros_all_max), through the front normal extended by d on the whole "
+                               "surface; false: R where the front can go within the step (d's band), the run's "
+                               "costs following the front")
+            .fallback(false),
         ParameterDecl::choice("slope", {"surface", "mesh"},
                               "surface: the slope from the input surface's smooth normal, one field whatever the "
                               "mesh; mesh: from the current mesh's vertex normals, which change with every remesh")
@@ -191,13 +197,14 @@ class FireModel final : public VelocityModel {
 
   std::vector<OutputDecl> outputs() const override {
     return {
-        OutputDecl::vertex_field("rate_of_spread", "m/s", "R at the vertices (through the extended front normal)"),
+        OutputDecl::vertex_field("rate_of_spread", "m/s", "R at the vertices near the front (0 beyond; with "
+                                                          "landscape_statistics, everywhere through the extended front normal)"),
         OutputDecl::vertex_field("arrival_time", "s", "the arrival-time grid sampled at the vertices (terrains)"),
         OutputDecl::metric("ros_min", "m/s", "smallest R on the front"),
         OutputDecl::metric("ros_mean", "m/s", "mean R on the front"),
         OutputDecl::metric("ros_max", "m/s", "largest R on the front"),
-        OutputDecl::metric("ros_all_mean", "m/s", "mean R over the whole surface"),
-        OutputDecl::metric("ros_all_max", "m/s", "largest R over the whole surface"),
+        OutputDecl::metric("ros_all_mean", "m/s", "with landscape_statistics: mean R over the whole surface"),
+        OutputDecl::metric("ros_all_max", "m/s", "with landscape_statistics: largest R over the whole surface"),
         OutputDecl::grid("arrival_time", "s", "the time the front reached each cell (terrains)")
             .combine(Combine::share("burn_probability", "burn probability over {members} members"))
             .combine(Combine::mean("arrival_mean", "s", "mean arrival time over the members that reached the cell"))
@@ -226,6 +233,7 @@ class FireModel final : public VelocityModel {
     arrival_.record({});
     huygens_ = p.choice("front_velocity") == "huygens";
     surface_slope_ = p.choice("slope") == "surface";
+    landscape_statistics_ = p.boolean("landscape_statistics");
 
     wind_height_ = WindHeight::midflame;
     if (p.has("wind")) {
@@ -340,9 +348,9 @@ class FireModel final : public VelocityModel {
     }
   }
 
-  // d on the whole surface: ros_all_mean/max are R over every vertex of the landscape, each with
-  // the extended n_Σ, which a band of d leaves undefined beyond its width.
-  ModelNeeds needs() const override { return {.whole_surface_distance = true}; }
+  // R needs d near the front only; the landscape's statistics (R over every vertex, each with the
+  // extended n_Σ) need it everywhere.
+  ModelNeeds needs() const override { return {.whole_surface_distance = landscape_statistics_}; }
 
   VelocityField compute(const StepContext& context) override {
     const SurfaceMesh& mesh = context.mesh();
@@ -364,13 +372,15 @@ class FireModel final : public VelocityModel {
 
     ScalarField speed(mesh.n_vertices(), 0.0);
     const std::span<const int> active = context.active_vertices();
+    // Where R is needed: a sub-step's active vertices, d's band in a banded state (empty: all).
+    const std::span<const int> band = context.band_vertices();
     if (!barriers_.empty()) {
       // The band's sub-steps work on the mesh of the state's own compute (T^n): its longest edge.
       if (active.empty() || !(barrier_reach_ > 0)) barrier_reach_ = barrier_reach(barriers_, longest_plan_edge(mesh));
-      mark_barrier_vertices(mesh, barriers_, barrier_reach_, active, stopped_);
+      mark_barrier_vertices(mesh, barriers_, barrier_reach_, band, stopped_);
     }
     if (rothermel_)
-      rothermel_spread_.update(mesh, normals, active, time, context.clock_start(), wind_, wind_height_,
+      rothermel_spread_.update(mesh, normals, band, time, context.clock_start(), wind_, wind_height_,
                                [&](double x, double y) { return fuel_at(x, y); });
     auto rate_in = [&](int v, const Vec3& n_sigma) {
       if (!barriers_.empty() && stopped_[std::size_t(v)]) return 0.0;  // a barrier: the front stops here
@@ -425,7 +435,10 @@ class FireModel final : public VelocityModel {
       }
       return VelocityField::normal(std::move(speed));
     }
-    for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
+    if (band.empty())
+      for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
+    else
+      for (int v : band) speed[v] = rate_at(v);
     rates_ = speed;  // the state's own compute: the rates the arrival raster records in its steps
     clock_start_ = context.clock_start();
     if (context.is_height_field()) record_perimeter(context);
@@ -433,8 +446,11 @@ class FireModel final : public VelocityModel {
     VelocityField field = VelocityField::normal(speed);
     if (huygens_) {
       field.kind = VelocityField::Kind::Tangential;
-      field.vector.resize(mesh.n_vertices());
-      for (auto v : mesh.vertices()) field.vector[v.idx()] = huygens_at(v.idx(), speed[v.idx()]);
+      field.vector.assign(mesh.n_vertices(), Vec3(0, 0, 0));
+      if (band.empty())
+        for (auto v : mesh.vertices()) field.vector[v.idx()] = huygens_at(v.idx(), speed[v.idx()]);
+      else
+        for (int v : band) field.vector[v] = huygens_at(v, speed[v]);
     }
     // Rate of spread on the front: vertices of interface edges.
     double lo = std::numeric_limits<double>::infinity(), hi = 0, sum = 0;
@@ -450,15 +466,15 @@ class FireModel final : public VelocityModel {
         sum += speed[v.idx()];
         ++count;
       }
-    // Over the whole landscape too (R is defined everywhere through the extended n_Σ): the speed
-    // field a figure of S coloured by R shows, a statistic that does not depend on where the front is.
-    double all_sum = 0, all_max = 0;
-    for (double r : speed) all_sum += r, all_max = std::max(all_max, r);
-    field.metrics = {{"ros_min", count ? lo : 0.0},
-                     {"ros_mean", count ? sum / double(count) : 0.0},
-                     {"ros_max", hi},
-                     {"ros_all_mean", speed.empty() ? 0.0 : all_sum / double(speed.size())},
-                     {"ros_all_max", all_max}};
+    field.metrics = {{"ros_min", count ? lo : 0.0}, {"ros_mean", count ? sum / double(count) : 0.0}, {"ros_max", hi}};
+    if (landscape_statistics_) {
+      // Over the whole landscape too (R is defined everywhere through the extended n_Σ): the speed
+      // field a figure of S coloured by R shows.
+      double all_sum = 0, all_max = 0;
+      for (double r : speed) all_sum += r, all_max = std::max(all_max, r);
+      field.metrics.emplace_back("ros_all_mean", speed.empty() ? 0.0 : all_sum / double(speed.size()));
+      field.metrics.emplace_back("ros_all_max", all_max);
+    }
     field.point_fields.emplace_back("rate_of_spread", speed);
     if (arrival_.initialised()) field.point_fields.emplace_back("arrival_time", arrival_.sample_at_vertices(mesh));
     return field;
@@ -694,6 +710,7 @@ class FireModel final : public VelocityModel {
   ArrivalRaster arrival_;
   bool huygens_ = true;  ///< front_velocity: V = R n + (dR/dθ) t (true) or R n (the paper's)
   bool surface_slope_ = true;  ///< slope: from S's smooth normal (true) or T^n's vertex normals
+  bool landscape_statistics_ = false;  ///< R on the whole landscape (d on the whole surface)
   ScalarField rates_;  ///< R at the vertices of the current state (the band's updated in sub-steps)
   std::string perimeter_file_ = config::have_gdal ? "perimeters.gpkg" : "";
   int perimeter_every_ = 1;

@@ -288,6 +288,14 @@ void bind_model_types(py::module_& m) {
             return view(active.data(), active.size(), 0, self);
           },
           "the vertices where V is needed (a narrow band); empty: every vertex")
+      .def_property_readonly(
+          "band_vertices",
+          [](py::object self) {
+            const auto band = self.cast<Step&>().get().band_vertices();
+            return view(band.data(), band.size(), 0, self);
+          },
+          "where V can matter: active_vertices in a sub-step, d's band and its ring in a banded state; "
+          "empty: every vertex")
       .def_property_readonly("conormal", [](py::object self) { return view(self.cast<Step&>().get().conormal(), self); },
                              "(n, 3) unit conormal ∇_S d / |∇_S d|")
       .def_property_readonly("vertex_normals",

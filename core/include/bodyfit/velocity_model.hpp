@@ -122,6 +122,11 @@ class StepContext {
   /// least the band's width). conormal() is then filled only at these vertices. A model may
   /// compute everywhere anyway (correct, slower). Empty: every vertex (the state's own compute).
   std::span<const int> active_vertices() const;
+  /// Where V can matter in this call (sorted): in a sub-step, active_vertices(); in a state whose
+  /// d is measured in a band, the band's vertices and their ring (beyond, d is flat and n_Σ 0);
+  /// empty when d is known on the whole surface (every vertex). conormal() and surface_normals()
+  /// are filled there only.
+  std::span<const int> band_vertices() const;
   /// The clock time of t = 0 in seconds since 1970-01-01T00:00:00Z, when the case gives one
   /// ([time] start): t^n is then the date-time clock_start + t^n (clock_time.hpp formats it).
   std::optional<double> clock_start() const;
@@ -133,7 +138,8 @@ class StepContext {
   /// interpolated at each vertex's closest point of S (ReferenceSurface::smooth_normal). One
   /// function of position whatever T^n is, where vertex_normals() change with every remesh: what a
   /// model whose V depends on S's orientation (a slope) should read. vertex_normals() when the
-  /// driver has no reference surface.
+  /// driver has no reference surface. Filled at band_vertices() only (0 beyond), each normal the
+  /// same whichever vertices are asked for.
   const VectorField& surface_normals() const;
   /// Unit conormal n_Σ = ∇_S d / |∇_S d| at the vertices, extended to the whole surface.
   const VectorField& conormal() const;
