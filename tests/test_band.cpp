@@ -10,6 +10,7 @@
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/levelset_mesher.hpp>
+#include <bodyfit/model_guard.hpp>
 #include <bodyfit/projection.hpp>
 
 #include "test_support.hpp"
@@ -184,6 +185,25 @@ TEST_CASE("a model that smooths over S is given d on the whole surface: the whol
 
 namespace {
 
+const char* kTerrainDisk = R"(
+[surface]
+generator = "terrain"
+extent = 40000.0
+h = 500.0
+seed = 7
+max_height = 1500.0
+feature_size = 3000.0
+[region]
+shape = "disks"
+centers = [[20000.0, 20000.0]]
+radii = [2000.0]
+[model]
+name = "conormal"
+[time]
+dt = 300.0
+iterations = 4
+)";
+
 /// V = n_Σ; records, for each banded state's compute, whether band_vertices() is d's band and its
 /// ring, and whether surface_normals() holds S's smooth normal there (bit for bit) and 0 beyond.
 class BandProbe final : public VelocityModel {
@@ -232,24 +252,7 @@ class BandProbe final : public VelocityModel {
 }  // namespace
 
 TEST_CASE("in a banded state, band_vertices() is d's band and its ring, and surface_normals() S's normals there") {
-  CaseSetup setup = setup_case(parse_case(toml::parse(R"(
-[surface]
-generator = "terrain"
-extent = 40000.0
-h = 500.0
-seed = 7
-max_height = 1500.0
-feature_size = 3000.0
-[region]
-shape = "disks"
-centers = [[20000.0, 20000.0]]
-radii = [2000.0]
-[model]
-name = "conormal"
-[time]
-dt = 300.0
-iterations = 4
-)")));
+  CaseSetup setup = setup_case(parse_case(toml::parse(kTerrainDisk)));
   auto surface = std::make_shared<ReferenceSurface>(setup.mesh);
   setup.options.remesh.reference = surface;
   setup.options.narrow_band = true;
@@ -260,4 +263,15 @@ iterations = 4
   CHECK(probe.smaller_than_mesh);
   CHECK(probe.normals_exact);  // each vertex's own search: the same normal whichever are asked for
   CHECK(probe.zero_beyond);
+  // A plugin built before ABI 3.3 may read S's normals anywhere: d on the whole surface, no band.
+  for (std::uint32_t minor : {2u, 3u}) {
+    CAPTURE(minor);
+    CaseSetup again = setup_case(parse_case(toml::parse(kTerrainDisk)));
+    again.options.remesh.reference = surface;
+    again.options.narrow_band = true;
+    BandProbe older(*surface);
+    GuardedModel guarded(older, 0, (3u << 16) | minor);
+    evolve(again.mesh, guarded, again.options, {}, EvolutionHooks::quiet());
+    CHECK(older.banded_states == (minor == 2 ? 0 : probe.banded_states));
+  }
 }

@@ -183,7 +183,7 @@ void GuardedModel::configure(Parameters& parameters) {
 
 ModelNeeds GuardedModel::needs() const {
   ModelNeeds needs = guarded("needs", iteration_, [&] { return model_.needs(); });
-  if (!plugin_has(abi_, kAbiBandedDistance)) needs.whole_surface_distance = true;
+  if (!plugin_has(abi_, kAbiBandNormals)) needs.whole_surface_distance = true;
   return needs;
 }
 

@@ -121,6 +121,37 @@ double spatial_disorder(const SurfaceMesh& mesh) {
   return total_live > 0 ? double(total_far + 6 * holes) / double(total_live) : 0.0;
 }
 
+double spatial_disorder_after_reorder(const SurfaceMesh& mesh) {
+  std::vector<Vec3> points;
+  std::vector<int> live;
+  for (auto v : mesh.vertices()) {
+    live.push_back(v.idx());
+    points.push_back(mesh.point(v));
+  }
+  const std::vector<int> order = z_order(points);
+  std::vector<int> rank(mesh.n_vertices(), -1);
+  for (std::size_t i = 0; i < order.size(); ++i) rank[std::size_t(live[std::size_t(order[i])])] = int(i);
+  const double window = 16 * std::sqrt(double(live.size()));
+  struct Count {
+    std::size_t far = 0, live = 0;
+  };
+  const Count count = reduce(
+      int(mesh.n_edges()), Count{},
+      [&](int i, Count& c) {
+        const EdgeHandle e(i);
+        if (mesh.status(e).deleted()) return;
+        const auto h = mesh.halfedge_handle(e, 0);
+        ++c.live;
+        c.far += std::abs(rank[std::size_t(mesh.from_vertex_handle(h).idx())] -
+                          rank[std::size_t(mesh.to_vertex_handle(h).idx())]) > window;
+      },
+      [](Count& total, const Count& c) {
+        total.far += c.far;
+        total.live += c.live;
+      });
+  return count.live > 0 ? double(count.far) / double(count.live) : 0.0;
+}
+
 bool has_deleted_elements(const SurfaceMesh& mesh) {
   auto any = [](int n, auto&& deleted) {
     return reduce(n, 0, [&](int i, int& found) { found = found || deleted(i); },

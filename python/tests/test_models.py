@@ -70,6 +70,38 @@ def test_python_model_from_python(cpp_run, tmp_path):
     np.testing.assert_array_equal(plain.history["area"], np.asarray(result.history["area"]))
 
 
+def test_band_vertices_in_a_banded_state(tmp_path):
+    """The state after the first has d in a band: band_vertices lists the band and its ring, where
+    the conormal is filled; the first state's d is whole (empty: every vertex)."""
+
+    class Probe:
+        name = "band_probe"
+
+        def __init__(self):
+            self.sizes = []
+
+        def compute(self, step):
+            band = np.asarray(step.band_vertices)
+            if len(step.active_vertices) == 0:
+                d = np.asarray(step.distance)
+                self.sizes.append((len(band), len(d)))
+                if len(band):
+                    assert np.all(np.diff(band) > 0)
+                    assert np.all(np.abs(d[band]) <= np.abs(d).max())
+                    outside = np.setdiff1d(np.arange(len(d)), band)
+                    assert np.all(np.asarray(step.conormal)[outside] == 0)
+            return {"velocity": np.asarray(step.conormal).copy()}
+
+    probe = Probe()
+    case = {"surface": {"generator": "sphere", "h": 0.04}, "region": {"shape": "cap", "axis": [0.0, 0.0, 1.0], "angle": 45.0},
+            "time": {"cfl": 0.5, "iterations": 4}, "remesh": {"hmax": 0.04, "hmin": 0.004}, "output": {"png_every": 0}}
+    bodyfit.run(case, out=tmp_path / "out", model=probe, progress=False)
+    # The first state and the final one (its outputs): d on the whole surface; between, a band.
+    assert probe.sizes[0][0] == 0 and probe.sizes[-1][0] == 0
+    assert len(probe.sizes) == 5
+    assert all(0 < band < 0.6 * n for band, n in probe.sizes[1:-1]), probe.sizes
+
+
 def test_a_case_python_model_from_python(cpp_run, tmp_path):
     """A case naming the python model runs from Python too (in this interpreter, not the plugin's)."""
     case = ROOT / "examples" / "python" / "sphere_cap_python.toml"

@@ -18,7 +18,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 3;
-inline constexpr std::uint32_t kPluginAbiMinor = 2;
+inline constexpr std::uint32_t kPluginAbiMinor = 3;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// A feature of the plugin interface and the ABI version that brought it.
@@ -44,6 +44,11 @@ inline constexpr AbiFeature kAbiNuclei{3, 1, "nuclei"};
 /// ModelNeeds::whole_surface_distance: a model built before it gets d on the whole surface (its
 /// needs() returns the shorter struct, and its author did not know d could be banded).
 inline constexpr AbiFeature kAbiBandedDistance{3, 2, "banded distance"};
+
+// The features of ABI 3.3.
+/// StepContext::band_vertices(), and surface_normals() filled there only in a banded state: a model
+/// built before it (which may read S's normals anywhere) gets d on the whole surface.
+inline constexpr AbiFeature kAbiBandNormals{3, 3, "band normals"};
 
 /// Whether a plugin built for `abi` has `feature`.
 constexpr bool plugin_has(std::uint32_t abi, AbiFeature feature) {
