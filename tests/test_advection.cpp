@@ -2,6 +2,7 @@
 // sphere, rigid rotation), inflow through an open boundary, paths through vertices and along edges,
 // determinism across thread counts, and the `bodyfit advect` command.
 #include <bodyfit/advection.hpp>
+#include <bodyfit/band_advector.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
@@ -522,6 +523,38 @@ TEST_CASE("an Advector built on the band's faces only: the whole mesh's band cal
   CHECK(report.outside_band > 0);
   CHECK(report.hit_boundary == 0);
   CHECK_THROWS_AS(band.advect(phi, velocity, T), std::logic_error);
+}
+
+TEST_CASE("BandAdvector: built around the band, built again when the band moves beyond it, the whole mesh's values") {
+  const SurfaceMesh mesh = make_sphere({.faces = 20 * 22 * 22});
+  const double h = edge_length_stats(mesh).mean;
+  const VectorField velocity = sample_vector(mesh, [](const Vec3& p) { return e_beta(p); });
+  Advector whole(mesh);
+  BandAdvector band_advector(mesh);
+  // A front at polar angle theta, its band and the vertices traced, advected by both Advectors.
+  auto same_as_whole = [&](double theta, int rings) {
+    ScalarField phi(mesh.n_vertices());
+    for (auto v : mesh.vertices()) phi[v.idx()] = std::acos(std::clamp(mesh.point(v)[2], -1.0, 1.0)) - theta;
+    std::vector<int> traced, known;
+    for (auto v : mesh.vertices()) {
+      if (std::abs(phi[v.idx()]) <= 2 * h) traced.push_back(v.idx());
+      if (std::abs(phi[v.idx()]) <= 6 * h) known.push_back(v.idx());
+    }
+    ScalarField expected(mesh.n_vertices(), 7.0), out(mesh.n_vertices(), 7.0);
+    AdvectionReport report;
+    whole.advect_band(phi, velocity, 2 * h, traced, known, expected);
+    band_advector.covering(known, rings).advect_band(phi, velocity, 2 * h, traced, known, out, {}, &report);
+    CHECK(report.outside_band == 0);
+    std::size_t differ = 0;
+    for (std::size_t v = 0; v < out.size(); ++v) differ += out[v] != expected[v];
+    return differ == 0;
+  };
+  CHECK(same_as_whole(M_PI / 3, 4));
+  CHECK(band_advector.builds() == 1);
+  CHECK(same_as_whole(M_PI / 3 + h, 4));  // still within the 4 rings built beyond the band
+  CHECK(band_advector.builds() == 1);
+  CHECK(same_as_whole(M_PI / 3 + 10 * h, 4));  // beyond them: built again, further on
+  CHECK(band_advector.builds() == 2);
 }
 
 TEST_CASE("Advector::advect_band_composed: sub-steps of a translation give the one-step result, not K interpolations") {

@@ -1,5 +1,5 @@
 // The sub-steps' Advector on the faces around a moving band.
-#include "band_advector.hpp"
+#include <bodyfit/band_advector.hpp>
 
 #include <algorithm>
 

@@ -3,7 +3,7 @@
 #include <bodyfit/evolution.hpp>
 #include <bodyfit/geometry.hpp>
 
-#include "band_advector.hpp"
+#include <bodyfit/band_advector.hpp>
 #include "step_state.hpp"
 
 #include <fmt/format.h>
