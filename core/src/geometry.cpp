@@ -207,15 +207,7 @@ std::uint64_t spread_bits(std::uint64_t x) {
 
 }  // namespace
 
-std::vector<int> z_order(const std::vector<Vec3>& points) {
-  BoundingBox box;
-  if (!points.empty()) box.min = box.max = points[0];
-  for (const Vec3& p : points) {
-    box.min.minimize(p);
-    box.max.maximize(p);
-  }
-  return z_order(points, box);
-}
+std::vector<int> z_order(const std::vector<Vec3>& points) { return z_order(points, bounding_box(points)); }
 
 std::vector<int> z_order(const std::vector<Vec3>& points, const BoundingBox& box) {
   const Vec3 extent = box.max - box.min;
@@ -236,6 +228,16 @@ std::vector<int> z_order(const std::vector<Vec3>& points, const BoundingBox& box
   std::vector<int> order(n);
   for (int i = 0; i < n; ++i) order[i] = keyed[i].second;
   return order;
+}
+
+BoundingBox bounding_box(std::span<const Vec3> points) {
+  BoundingBox box;
+  if (!points.empty()) box.min = box.max = points[0];
+  for (const Vec3& p : points) {
+    box.min.minimize(p);
+    box.max.maximize(p);
+  }
+  return box;
 }
 
 BoundingBox bounding_box(const SurfaceMesh& mesh) {

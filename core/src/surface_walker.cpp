@@ -49,10 +49,7 @@ Surface build_surface(const SurfaceMesh& mesh, std::span<const int> subset) {
     std::vector<Vec3> points;
     for (int v = 0; v < nv; ++v)
       if (used[v]) built.push_back(v), points.push_back(s.points[v]);
-    BoundingBox box;
-    if (nv > 0) box.min = box.max = s.points[0];
-    for (const Vec3& p : s.points) box.min.minimize(p), box.max.maximize(p);
-    for (int k : z_order(points, box)) s.vertex_order.push_back(built[std::size_t(k)]);
+    for (int k : z_order(points, bounding_box(s.points))) s.vertex_order.push_back(built[std::size_t(k)]);
     for (int k = 0; k < int(s.vertex_order.size()); ++k) rank[s.vertex_order[std::size_t(k)]] = k;
   } else {
     rank.resize(nv);

@@ -4,8 +4,8 @@
 #include <bodyfit/mesh.hpp>
 
 #include <array>
-#include <span>
 #include <functional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -54,6 +54,7 @@ struct BoundingBox {
   double diagonal() const { return (max - min).norm(); }
 };
 BoundingBox bounding_box(const SurfaceMesh& mesh);
+BoundingBox bounding_box(std::span<const Vec3> points);
 /// Indices of the points sorted by their Z-order (Morton) code in the points' bounding box (21 bits
 /// per axis), ties by index: a deterministic, spatially coherent order for cache-friendly sweeps.
 std::vector<int> z_order(const std::vector<Vec3>& points);
