@@ -199,6 +199,7 @@ class Evolution {
                                       "declare ModelNeeds::may_reject",
                                       model_.name(), n_ + 1));
       mesh_ = *kept_mesh;  // restore T^n exactly
+      mean_edge_ = NAN;
       candidate_ = false;
       distance_ = kept_distance;
       distance_width_ = kept_width_;
@@ -533,7 +534,13 @@ class Evolution {
     return ratio > 1 + 1e-9 ? remaining / std::ceil(ratio - 1e-9) : remaining;  // 3.0000000000000004 is 3
   }
 
-  double cfl_length() const { return options_.cfl_length > 0 ? options_.cfl_length : mean_edge_length(mesh_); }
+  /// h of the CFL condition: [time] cfl_length, or T^n's mean edge length (a pass over its edges,
+  /// taken once per mesh: every sub-step asks for it).
+  double cfl_length() const {
+    if (options_.cfl_length > 0) return options_.cfl_length;
+    if (std::isnan(mean_edge_)) mean_edge_ = mean_edge_length(mesh_);
+    return mean_edge_;
+  }
 
   /// The model's new components of G: φ^{n+1} ← min(φ^{n+1}, ψ) on T^n, and the same for d^n where
   /// drop_detached looks for what G^{n+1} grew from (a nucleus is not a detached part).
@@ -581,7 +588,8 @@ class Evolution {
     try {
       return review_candidate(step, attempt);
     } catch (...) {
-      if (kept_mesh) mesh_ = *kept_mesh, distance_ = kept_distance, distance_width_ = kept_width_, candidate_ = false;
+      if (kept_mesh)
+        mesh_ = *kept_mesh, distance_ = kept_distance, distance_width_ = kept_width_, mean_edge_ = NAN, candidate_ = false;
       throw;
     }
   }
@@ -691,7 +699,7 @@ class Evolution {
   /// CFL sub-steps of the next step (same mesh).
   void measure_distance(bool same_mesh = false) {
     if (!same_mesh || !solver_) solver_.emplace(mesh_);
-    if (!same_mesh) longest_edge_ = longest_edge(mesh_);
+    if (!same_mesh) longest_edge_ = longest_edge(mesh_), mean_edge_ = NAN;
     DistanceOptions options = options_.distance;
     if (banded_) options.narrow_band = std::min(options.narrow_band, band_width_);
     distance_ = distance_of(mesh_, *solver_, options);
@@ -742,6 +750,7 @@ class Evolution {
   /// band_width_ is what the next measure uses (∞ until a step has sized it).
   double distance_width_ = INFINITY, band_width_ = INFINITY, kept_width_ = INFINITY;
   double longest_edge_ = 0;     ///< of the current mesh
+  mutable double mean_edge_ = NAN;  ///< of the current mesh, once asked for (cfl_length)
   std::optional<DistanceSolver> solver_;  ///< on the current mesh (distance_'s, then the sub-steps')
   VelocityField state_field_;   ///< the model's answer on T^n (first sub-step of the first attempt)
   VectorField state_velocity_;  ///< V^n
