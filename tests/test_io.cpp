@@ -1326,3 +1326,74 @@ TEST_CASE("a vertex written twice is merged into the first: the surface comes ba
   CHECK(boundary == 0);
   CHECK(enclosed_volume(mesh) == doctest::Approx(1.0 / 6.0).epsilon(1e-12));
 }
+
+namespace {
+
+/// The corners of every face, in face order.
+std::vector<std::int64_t> corners_of(const SurfaceMesh& mesh) {
+  std::vector<std::int64_t> corners;
+  for (auto f : mesh.faces())
+    for (auto v : mesh.fv_range(f)) corners.push_back(v.idx());
+  return corners;
+}
+
+/// The mesh OpenMesh's add_face builds from these corners, one triangle after the other.
+SurfaceMesh built_by_add_face(const SurfaceMesh& points_from, const std::vector<std::int64_t>& corners) {
+  SurfaceMesh mesh;
+  for (auto v : points_from.vertices()) mesh.add_vertex(points_from.point(v));
+  for (std::size_t t = 0; t < corners.size(); t += 3)
+    REQUIRE(mesh.add_face(VertexHandle(int(corners[t])), VertexHandle(int(corners[t + 1])),
+                          VertexHandle(int(corners[t + 2])))
+                .is_valid());
+  return mesh;
+}
+
+/// Every connectivity array of the two meshes is the same.
+void check_same_connectivity(const SurfaceMesh& a, const SurfaceMesh& b) {
+  REQUIRE(a.n_vertices() == b.n_vertices());
+  REQUIRE(a.n_edges() == b.n_edges());
+  REQUIRE(a.n_faces() == b.n_faces());
+  std::size_t differences = 0;
+  for (auto h : a.halfedges()) {
+    const HalfedgeHandle g(h.idx());
+    differences += a.to_vertex_handle(h) != b.to_vertex_handle(g) ||
+                   a.next_halfedge_handle(h) != b.next_halfedge_handle(g) ||
+                   a.prev_halfedge_handle(h) != b.prev_halfedge_handle(g) || a.face_handle(h) != b.face_handle(g);
+  }
+  for (auto v : a.vertices()) differences += a.halfedge_handle(v) != b.halfedge_handle(VertexHandle(v.idx()));
+  for (auto f : a.faces()) differences += a.halfedge_handle(f) != b.halfedge_handle(FaceHandle(f.idx()));
+  CHECK(differences == 0);
+}
+
+void check_reader_builds_as_add_face(const SurfaceMesh& shape, std::vector<std::int64_t> corners) {
+  std::vector<double> xyz;
+  for (auto v : shape.vertices())
+    for (int i = 0; i < 3; ++i) xyz.push_back(shape.point(v)[i]);
+  const SurfaceMesh read = mesh_from_arrays(xyz, corners, {}, "arrays");
+  check_same_connectivity(read, built_by_add_face(shape, corners));
+}
+
+}  // namespace
+
+TEST_CASE("a read mesh's connectivity is add_face's, array for array: closed, open, shuffled, real parts") {
+  SUBCASE("closed sphere") { check_reader_builds_as_add_face(make_sphere({.faces = 5000}), corners_of(make_sphere({.faces = 5000}))); }
+  SUBCASE("open square") { check_reader_builds_as_add_face(make_plane({.h = 0.2}), corners_of(make_plane({.h = 0.2}))); }
+  SUBCASE("triangles in random order: vertices join several fans before they close") {
+    for (const SurfaceMesh& shape : {make_sphere({.faces = 5000}), make_plane({.h = 0.2})}) {
+      auto corners = corners_of(shape);
+      std::vector<std::array<std::int64_t, 3>> triangles(corners.size() / 3);
+      std::memcpy(triangles.data(), corners.data(), corners.size() * sizeof(std::int64_t));
+      std::shuffle(triangles.begin(), triangles.end(), std::mt19937(7));
+      std::memcpy(corners.data(), triangles.data(), corners.size() * sizeof(std::int64_t));
+      check_reader_builds_as_add_face(shape, corners);
+    }
+  }
+  SUBCASE("public meshes with boundaries, handles and creases") {
+    for (const char* name : {"anchor", "elephant-with-holes", "fandisk", "knot1"}) {
+      const fs::path file = fs::path(BODYFIT_SOURCE_DIR) / "meshes/public" / (std::string(name) + ".off");
+      REQUIRE_MESSAGE(fs::exists(file), file.string() << " is missing: run scripts/setup.sh");
+      const SurfaceMesh shape = read_mesh(file);
+      check_reader_builds_as_add_face(shape, corners_of(shape));
+    }
+  }
+}

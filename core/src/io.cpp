@@ -1,5 +1,6 @@
 // Mesh I/O: format dispatch and the validated builder shared by every reader.
 #include "io_internal.hpp"
+#include "mesh_connectivity.hpp"
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
@@ -264,7 +265,11 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     auto v = mesh.add_vertex(r.points[i]);
     mesh.vertex_ref(v) = i < r.vertex_refs.size() ? r.vertex_refs[i] : 0;
   }
-  {
+  // The connectivity in a few array passes; triangle by triangle only to say what is wrong.
+  if (build_connectivity(mesh, {r.triangles.data(), r.triangles.size()})) {
+    for (std::size_t t = 0; t < r.triangles.size() && t < r.triangle_refs.size(); ++t)
+      mesh.region(FaceHandle(int(t))) = r.triangle_refs[t];
+  } else {
     SilenceOpenMeshErrors silence;
     for (std::size_t t = 0; t < r.triangles.size(); ++t) {
       const auto& tri = r.triangles[t];

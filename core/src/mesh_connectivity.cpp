@@ -1,0 +1,114 @@
+// The halfedge connectivity of a triangle mesh from its corners: add_face's arrays without add_face.
+#include "mesh_connectivity.hpp"
+
+#include <cstddef>
+#include <vector>
+
+namespace bodyfit {
+namespace {
+
+// Triangle t's side i is the "corner halfedge" k = 3t + i, from corner i to corner i + 1.
+constexpr int next_in_triangle(int k) { return k % 3 == 2 ? k - 2 : k + 1; }
+constexpr int previous_in_triangle(int k) { return k % 3 == 0 ? k + 2 : k - 1; }
+
+}  // namespace
+
+bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64_t, 3>> corners) {
+  const int nv = int(mesh.n_vertices());
+  const int nk = 3 * int(corners.size());
+  auto from = [&](int k) { return int(corners[std::size_t(k / 3)][std::size_t(k % 3)]); };
+  std::vector<int> to(std::size_t(nk), 0);
+  for (int k = 0; k < nk; ++k) to[std::size_t(k)] = from(next_in_triangle(k));
+
+  // Each vertex's outgoing corner halfedges, in triangle order.
+  std::vector<int> first_out(std::size_t(nv) + 1, 0), out(std::size_t(nk), 0);
+  for (int k = 0; k < nk; ++k) ++first_out[std::size_t(from(k)) + 1];
+  for (int v = 0; v < nv; ++v) first_out[std::size_t(v) + 1] += first_out[std::size_t(v)];
+  {
+    std::vector<int> filled(first_out.begin(), first_out.end() - 1);
+    for (int k = 0; k < nk; ++k) out[std::size_t(filled[std::size_t(from(k))]++)] = k;
+  }
+
+  // Twins; a side used twice in one direction, or a triangle repeated the other way round, is not a
+  // manifold surface.
+  std::vector<int> twin(std::size_t(nk), -1);
+  for (int k = 0; k < nk; ++k) {
+    const int a = from(k), b = to[std::size_t(k)];
+    for (int i = first_out[std::size_t(a)]; i < first_out[std::size_t(a) + 1]; ++i)
+      if (out[std::size_t(i)] != k && to[std::size_t(out[std::size_t(i)])] == b) return false;
+    for (int i = first_out[std::size_t(b)]; i < first_out[std::size_t(b) + 1]; ++i) {
+      const int j = out[std::size_t(i)];
+      if (to[std::size_t(j)] != a) continue;
+      if (from(previous_in_triangle(k)) == from(previous_in_triangle(j))) return false;
+      twin[std::size_t(k)] = j;
+    }
+  }
+
+  // Each vertex's triangles one fan: turning around it from one of its sides reaches all of them.
+  for (int v = 0; v < nv; ++v) {
+    const int degree = first_out[std::size_t(v) + 1] - first_out[std::size_t(v)];
+    if (degree == 0) continue;
+    const int start = out[std::size_t(first_out[std::size_t(v)])];
+    int reached = 1;
+    bool open = false;
+    for (int k = start;;) {
+      const int t = twin[std::size_t(k)];
+      if (t < 0) {
+        open = true;
+        break;
+      }
+      k = next_in_triangle(t);
+      if (k == start) break;
+      if (++reached > degree) return false;
+    }
+    if (open)
+      for (int k = start;;) {
+        const int t = twin[std::size_t(previous_in_triangle(k))];
+        if (t < 0) break;
+        k = t;
+        if (++reached > degree) return false;
+      }
+    if (reached != degree) return false;
+  }
+
+  // Edges numbered as add_face creates them: at a side's first use, in triangle then corner order,
+  // the edge's first halfedge along that side.
+  std::vector<int> halfedge(static_cast<std::size_t>(nk), 0);
+  int ne = 0;
+  for (int k = 0; k < nk; ++k) {
+    const int t = twin[std::size_t(k)];
+    halfedge[std::size_t(k)] = (t < 0 || t > k) ? 2 * ne++ : halfedge[std::size_t(t)] ^ 1;
+  }
+
+  mesh.resize(std::size_t(nv), std::size_t(ne), corners.size());
+  std::vector<int> boundary_out(std::size_t(nv), -1);
+  for (int k = 0; k < nk; ++k) {
+    const HalfedgeHandle h(halfedge[std::size_t(k)]);
+    mesh.set_vertex_handle(h, VertexHandle(to[std::size_t(k)]));
+    mesh.set_face_handle(h, FaceHandle(k / 3));
+    mesh.set_next_halfedge_handle(h, HalfedgeHandle(halfedge[std::size_t(next_in_triangle(k))]));
+    if (twin[std::size_t(k)] < 0) {
+      const HalfedgeHandle b(halfedge[std::size_t(k)] ^ 1);
+      mesh.set_vertex_handle(b, VertexHandle(from(k)));
+      mesh.set_face_handle(b, FaceHandle());
+      boundary_out[std::size_t(to[std::size_t(k)])] = b.idx();
+    }
+  }
+  // A boundary halfedge ends where the next one leaves (one per vertex: each vertex is one fan).
+  for (int k = 0; k < nk; ++k)
+    if (twin[std::size_t(k)] < 0)
+      mesh.set_next_halfedge_handle(HalfedgeHandle(halfedge[std::size_t(k)] ^ 1),
+                                    HalfedgeHandle(boundary_out[std::size_t(from(k))]));
+  for (std::size_t t = 0; t < corners.size(); ++t)
+    mesh.set_halfedge_handle(FaceHandle(int(t)), HalfedgeHandle(halfedge[3 * t + 2]));
+  for (int v = 0; v < nv; ++v) {
+    const int last = first_out[std::size_t(v) + 1];
+    if (boundary_out[std::size_t(v)] >= 0)
+      mesh.set_halfedge_handle(VertexHandle(v), HalfedgeHandle(boundary_out[std::size_t(v)]));
+    else if (last > first_out[std::size_t(v)])
+      mesh.set_halfedge_handle(VertexHandle(v), HalfedgeHandle(halfedge[std::size_t(out[std::size_t(last - 1)])]));
+  }
+  return true;
+}
+
+}  // namespace bodyfit
