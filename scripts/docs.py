@@ -54,7 +54,7 @@ def run(command, **kwargs):
 def portable(text, build):
     """--help names this build's data directory and this machine's face budget: not the manual's."""
     text = text.replace(str(build / "share" / "bodyfit"), "<prefix>/share/bodyfit")
-    return re.sub(r"--max-faces UINT=\d+", "--max-faces UINT", text)
+    return re.sub(r"(--max-faces UINT[^=\n]*)=\d+", r"\1", text)
 
 
 def command_line_page(bodyfit, build):
