@@ -167,3 +167,30 @@ TEST_CASE("--threads: the same final mesh, byte for byte, with 1 and 2 worker th
   CHECK(bodyfit::test::read_file(dir / "one" / "final.sol") == bodyfit::test::read_file(dir / "two" / "final.sol"));
   CHECK(bodyfit::test::run_bodyfit("--threads -1 mesh sphere --faces 320 -o " + (dir / "x.mesh").string()).exit_code == 2);
 }
+
+TEST_CASE("one-shot commands restart on huge pages unless GLIBC_TUNABLES names the choice, with the same bytes out") {
+  TempDir dir("huge_pages");
+  std::string mode;
+  std::getline(std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"), mode);
+  const bool available = !mode.empty() && mode.find("[never]") == std::string::npos;
+  const auto sphere = dir / "s.mesh";
+  REQUIRE(run_bodyfit("-q mesh sphere --faces 2000 -o '" + sphere.string() + "'").exit_code == 0);
+  const char* before = std::getenv("GLIBC_TUNABLES");
+  const std::string saved = before ? before : "";
+  auto remesh = [&](const char* tunables, const std::string& out) {
+    if (tunables) ::setenv("GLIBC_TUNABLES", tunables, 1);
+    else ::unsetenv("GLIBC_TUNABLES");
+    auto r = run_bodyfit("-v remesh '" + sphere.string() + "' --hmax 0.15 -o '" + (dir / out).string() + "'");
+    CHECK(r.exit_code == 0);
+    return r.output.find("heap on transparent huge pages") != std::string::npos;
+  };
+  CHECK(remesh(nullptr, "default.mesh") == available);
+  CHECK(remesh("glibc.malloc.arena_max=4", "other.mesh") == available);  // the user's tunables kept, ours added
+  CHECK_FALSE(remesh("glibc.malloc.hugetlb=0", "off.mesh"));
+  if (before) ::setenv("GLIBC_TUNABLES", saved.c_str(), 1);
+  else ::unsetenv("GLIBC_TUNABLES");
+  const std::string reference = bodyfit::test::read_file(dir / "off.mesh");
+  CHECK_FALSE(reference.empty());
+  CHECK(bodyfit::test::read_file(dir / "default.mesh") == reference);
+  CHECK(bodyfit::test::read_file(dir / "other.mesh") == reference);
+}

@@ -67,7 +67,8 @@ bodyfit::cli::Command setup_advect(CLI::App& app) {
                 mesh.n_vertices(), mesh.n_faces(), args->time, args->options.rk_order, report.traced, report.substeps,
                 report.hit_boundary, report.lost, advect_ms, read_ms, ms_since(start), args->output);
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(40, setup_advect);

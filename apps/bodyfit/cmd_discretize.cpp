@@ -79,7 +79,8 @@ bodyfit::cli::Command setup_discretize(CLI::App& app) {
             bodyfit::write_mesh(mesh, *output);
             spdlog::info("wrote {} ({:.1f} ms)", *output, clock.lap());
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(55, setup_discretize);

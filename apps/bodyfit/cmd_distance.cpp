@@ -56,7 +56,8 @@ bodyfit::cli::Command setup_distance(CLI::App& app) {
                 report.setup_ms + report.init_ms + report.march_ms, report.setup_ms, report.init_ms, report.march_ms,
                 total, args->output);
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(30, setup_distance);

@@ -23,7 +23,8 @@ bodyfit::cli::Command setup_info(CLI::App& app) {
             const auto info = bodyfit::describe_mesh(mesh);
             std::fputs((*json ? bodyfit::to_json(info, *file) : bodyfit::to_text(info, *file)).c_str(), stdout);
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(20, setup_info);

@@ -98,7 +98,8 @@ bodyfit::cli::Command setup_mesh(CLI::App& app) {
               report("terrain", mesh, *output);
             }
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(10, setup_mesh);

@@ -44,7 +44,8 @@ bodyfit::cli::Command setup_remesh(CLI::App& app) {
                          report.passes, bodyfit::to_string(report.stop), report.max_edge_ratio, report.long_edges,
                          report.milliseconds, total, *output);
             return 0;
-          }};
+          },
+          /*on_huge_pages=*/true};
 }
 
 BODYFIT_COMMAND(60, setup_remesh);

@@ -12,6 +12,9 @@ namespace bodyfit::cli {
 struct Command {
   CLI::App* app = nullptr;
   std::function<int()> run;
+  /// A one-shot stage whose time goes mostly into first touching its arrays: run on huge pages
+  /// (huge_page_heap.hpp).
+  bool on_huge_pages = false;
 };
 /// Adds the subcommand to `app` and returns it with its runner.
 using CommandSetup = std::function<Command(CLI::App& app)>;

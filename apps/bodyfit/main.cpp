@@ -1,5 +1,6 @@
 // bodyfit: body-fitted tracking of a region moving inside a fixed surface.
 #include "commands.hpp"
+#include "huge_page_heap.hpp"
 #include "validators.hpp"
 #include "mmg_spellings.hpp"
 #include "self_documentation.hpp"
@@ -119,6 +120,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : int(ExitCode::Usage);  // not CLI11's raw 105-114
   }
 
+  for (const auto& command : added)
+    if (command.app->parsed() && command.on_huge_pages) cli::restart_on_huge_pages(argv);
+
   set_max_faces(max_faces);
   // oneTBB's limit for the whole process, the plugins' parallel loops included.
   std::optional<tbb::global_control> thread_limit;
@@ -133,8 +137,12 @@ int main(int argc, char** argv) {
                                            : spdlog::level::info);
 
   try {
-    for (auto& command : added)
-      if (command.app->parsed()) return command.run();
+    for (auto& command : added) {
+      if (!command.app->parsed()) continue;
+      if (command.on_huge_pages && cli::heap_on_huge_pages())
+        spdlog::debug("heap on transparent huge pages (GLIBC_TUNABLES glibc.malloc.hugetlb=1)");
+      return command.run();
+    }
     spdlog::error("no subcommand given (see --help)");
     return int(ExitCode::Usage);
   } catch (const std::exception& e) {
