@@ -1,11 +1,15 @@
 // The halfedge connectivity of a triangle mesh from its corners: add_face's arrays without add_face.
 #include "mesh_connectivity.hpp"
 
+#include "io_internal.hpp"
+
 #include <cstddef>
-#include <vector>
 
 namespace bodyfit {
 namespace {
+
+// Working arrays on huge pages (io_internal.hpp): they are as big as the mesh and freshly touched.
+using Array = io_detail::BulkVector<int>;
 
 // Triangle t's side i is the "corner halfedge" k = 3t + i, from corner i to corner i + 1.
 constexpr int next_in_triangle(int k) { return k % 3 == 2 ? k - 2 : k + 1; }
@@ -17,21 +21,21 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
   const int nv = int(mesh.n_vertices());
   const int nk = 3 * int(corners.size());
   auto from = [&](int k) { return int(corners[std::size_t(k / 3)][std::size_t(k % 3)]); };
-  std::vector<int> to(std::size_t(nk), 0);
+  Array to(std::size_t(nk), 0);
   for (int k = 0; k < nk; ++k) to[std::size_t(k)] = from(next_in_triangle(k));
 
   // Each vertex's outgoing corner halfedges, in triangle order.
-  std::vector<int> first_out(std::size_t(nv) + 1, 0), out(std::size_t(nk), 0);
+  Array first_out(std::size_t(nv) + 1, 0), out(std::size_t(nk), 0);
   for (int k = 0; k < nk; ++k) ++first_out[std::size_t(from(k)) + 1];
   for (int v = 0; v < nv; ++v) first_out[std::size_t(v) + 1] += first_out[std::size_t(v)];
   {
-    std::vector<int> filled(first_out.begin(), first_out.end() - 1);
+    Array filled(first_out.begin(), first_out.end() - 1);
     for (int k = 0; k < nk; ++k) out[std::size_t(filled[std::size_t(from(k))]++)] = k;
   }
 
   // Twins; a side used twice in one direction, or a triangle repeated the other way round, is not a
   // manifold surface.
-  std::vector<int> twin(std::size_t(nk), -1);
+  Array twin(std::size_t(nk), -1);
   for (int k = 0; k < nk; ++k) {
     const int a = from(k), b = to[std::size_t(k)];
     for (int i = first_out[std::size_t(a)]; i < first_out[std::size_t(a) + 1]; ++i)
@@ -73,7 +77,7 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
 
   // Edges numbered as add_face creates them: at a side's first use, in triangle then corner order,
   // the edge's first halfedge along that side.
-  std::vector<int> halfedge(static_cast<std::size_t>(nk), 0);
+  Array halfedge(static_cast<std::size_t>(nk), 0);
   int ne = 0;
   for (int k = 0; k < nk; ++k) {
     const int t = twin[std::size_t(k)];
@@ -81,7 +85,7 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
   }
 
   mesh.resize(std::size_t(nv), std::size_t(ne), corners.size());
-  std::vector<int> boundary_out(std::size_t(nv), -1);
+  Array boundary_out(std::size_t(nv), -1);
   for (int k = 0; k < nk; ++k) {
     const HalfedgeHandle h(halfedge[std::size_t(k)]);
     mesh.set_vertex_handle(h, VertexHandle(to[std::size_t(k)]));
