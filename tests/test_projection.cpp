@@ -1,0 +1,114 @@
+// The projection onto S is the nearest point of all its triangles, with or without a hint, near S
+// or far from it: checked against the brute-force minimum over every triangle, on meshes with
+// creases, holes, triangles of very different sizes and sheets a hair apart.
+#include <doctest/doctest.h>
+
+#include <bodyfit/generators.hpp>
+#include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
+#include <bodyfit/projection.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "test_support.hpp"
+
+using namespace bodyfit;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Squared distance from p to the nearest of all the triangles of `mesh`.
+double brute_force_distance2(const SurfaceMesh& mesh, const Vec3& p) {
+  double best = std::numeric_limits<double>::max();
+  for (auto f : mesh.faces()) {
+    auto [a, b, c] = face_points(mesh, f);
+    best = std::min(best, (closest_point_on_triangle(p, a, b, c) - p).sqrnorm());
+  }
+  return best;
+}
+
+/// Points near and far from every kind of place of S, asked with no hint, with the right one and
+/// with a wrong one: the distance found is the brute-force minimum and the point lies on the face
+/// reported.
+void check_nearest(const SurfaceMesh& mesh, int samples) {
+  const ReferenceSurface surface(mesh);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const int nf = int(mesh.n_faces());
+  double size = 0;  // the bounding box's diagonal
+  {
+    Vec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (auto v : mesh.vertices()) {
+      lo.minimize(mesh.point(v));
+      hi.maximize(mesh.point(v));
+    }
+    size = (hi - lo).norm();
+  }
+  int checked = 0;
+  for (int s = 0; s < samples; ++s) {
+    const FaceHandle f(int(random() % std::uint32_t(nf)));
+    auto [a, b, c] = face_points(mesh, f);
+    double u = unit(random), v = unit(random);
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    const Vec3 on = a + (b - a) * u + (c - a) * v;
+    const double edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    // Off S along its normal and sideways, from a thousandth of an edge to far outside the part.
+    const Vec3 n = face_normal(mesh, f);
+    const Vec3 side = Vec3(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5);
+    const double scales[] = {0.0, 1e-3 * edge, 0.3 * edge, 2 * edge, 0.05 * size, 3 * size};
+    const double scale = scales[s % 6];
+    const Vec3 p = on + n * (scale * (unit(random) - 0.5) * 2) + side * scale;
+    const double exact = brute_force_distance2(mesh, p);
+    for (int hint : {-1, f.idx(), int(random() % std::uint32_t(nf))}) {
+      const SurfacePoint q = surface.closest(p, hint);
+      REQUIRE(q.face >= 0);
+      // The same distance, to rounding (a triangle's vertices may be taken in another order here).
+      const double found = (q.point - p).norm();
+      INFO("sample " << s << " scale " << scale << " hint " << hint);
+      CHECK(std::abs(found - std::sqrt(exact)) <= 1e-13 * size);
+      auto [qa, qb, qc] = face_points(mesh, FaceHandle(q.face));
+      CHECK((closest_point_on_triangle(q.point, qa, qb, qc) - q.point).norm() <= 1e-12 * size);
+      ++checked;
+    }
+  }
+  CHECK(checked == 3 * samples);
+}
+
+}  // namespace
+
+TEST_CASE("ReferenceSurface::closest is the nearest of all the triangles: a sphere, a creased part, meshes with holes") {
+  SUBCASE("a geodesic sphere") { check_nearest(make_sphere({.faces = 20000}), 600); }
+  SUBCASE("public meshes: creases, boundaries, handles, very uneven triangles") {
+    for (const char* name : {"fandisk", "anchor", "knot1", "elephant-with-holes"}) {
+      const fs::path file = fs::path(BODYFIT_SOURCE_DIR) / "meshes/public" / (std::string(name) + ".off");
+      REQUIRE_MESSAGE(fs::exists(file), file.string() << " is missing: run scripts/setup.sh");
+      check_nearest(read_mesh(file), 300);
+    }
+  }
+}
+
+TEST_CASE("ReferenceSurface::closest among triangles of very different sizes, and two sheets a hair apart") {
+  // A plane square of two huge triangles beside a finely tessellated patch (triangles 600 times
+  // smaller), a second sheet 1e-3 above the patch and a parallel plane above the big square.
+  SurfaceMesh mesh;
+  auto quad = [&](Vec3 o, Vec3 du, Vec3 dv, int n) {
+    std::vector<VertexHandle> vh;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) vh.push_back(mesh.add_vertex(o + du * (double(i) / n) + dv * (double(j) / n)));
+    auto id = [&](int i, int j) { return vh[std::size_t(j) * std::size_t(n + 1) + std::size_t(i)]; };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        mesh.add_face(id(i, j), id(i + 1, j), id(i + 1, j + 1));
+        mesh.add_face(id(i, j), id(i + 1, j + 1), id(i, j + 1));
+      }
+  };
+  quad(Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 10, 0), 1);       // two triangles of side 10
+  quad(Vec3(11, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), 60);       // 7,200 triangles of side 1/60
+  quad(Vec3(11, 0, 1e-3), Vec3(1, 0, 0), Vec3(0, 1, 0), 7);     // a second sheet 1e-3 above
+  quad(Vec3(0, 0, 2), Vec3(10, 0, 0), Vec3(0, 10, 0), 25);      // a parallel plane above the big one
+  check_nearest(mesh, 1800);
+}
