@@ -39,7 +39,8 @@ void Remesher::seed_work() {
     return;
   }
   // One parallel sweep over the faces finds both kinds of seeds (each edge looked at from one of its
-  // faces); they are marked in index order, faces then edges, as serial sweeps would.
+  // faces; with RemeshOptions::changed, only faces with a changed vertex); they are marked in index order,
+  // faces then edges, as serial sweeps would.
   struct Seeds {
     std::vector<FaceHandle> poor;
     std::vector<EdgeHandle> off;
@@ -51,6 +52,11 @@ void Remesher::seed_work() {
     Seeds& out = blocks[std::size_t(b)];
     for (int i = b * kBlock; i < std::min(nf, (b + 1) * kBlock); ++i) {
       FaceHandle f(i);
+      if (opt_.changed) {
+        bool changed = false;
+        for (auto v : m_.fv_range(f)) changed = changed || opt_.changed(v);
+        if (!changed) continue;
+      }
       auto p = points(f);
       if (triangle(p[0], p[1], p[2]).quality < kGoodQuality) out.poor.push_back(f);
       for (auto h : m_.fh_range(f)) {
@@ -101,17 +107,19 @@ void Remesher::split_long_edges() {
   // No size is below hmin, so edges of hmin covering the surface bound what splitting can make (4×
   // for the gradation and the rounds' leftovers): beyond, splits no longer bring triangles to size
   // (a needle to a far vertex, split along its length into ever more needles) and would not end.
-  // The surface's area, a pass over every face, only once there is something to split.
-  double area = -1, bound = 0;
+  // The bound is at least twice the faces: the surface's area, a pass over every face, only once a
+  // round would add more faces than the mesh has.
+  const double faces_before = double(m_.n_faces());
+  double area = -1, bound = 2 * faces_before;
   while (true) {
     ranked_.clear();
     for (auto e : edges_)
       if (!m_.status(e).deleted())
         if (double r = ratio(e); r > kSplitRatio) ranked_.emplace_back(r, e);
     if (ranked_.empty()) break;
-    if (area < 0) {
+    if (area < 0 && double(m_.n_faces() + 2 * ranked_.size()) > bound) {
       area = total_area(m_);
-      bound = 4 * faces_for_edge_length(area, hmin_) + 2.0 * double(m_.n_faces());
+      bound += 4 * faces_for_edge_length(area, hmin_);
     }
     // Longest first; ties by index, so the order never depends on how the list was gathered.
     std::sort(ranked_.begin(), ranked_.end(), [](const auto& x, const auto& y) {
@@ -218,6 +226,14 @@ std::size_t Remesher::pass() {
 // its target, the edges still above the split bound, the quality, the degenerate triangles and the
 // faces the repair starts from (one sweep over the faces, in fixed blocks so that the sums and lists
 // do not depend on the number of threads).
+// Whether a face has a vertex this remesh queued or moved, or one its caller marked changed: with
+// RemeshOptions::changed, the slivers elsewhere are those the last remesh could not repair.
+bool Remesher::near_change(FaceHandle f) const {
+  for (auto v : m_.fv_range(f))
+    if (m_.property(touched_, v) || opt_.changed(v)) return true;
+  return false;
+}
+
 void Remesher::final_sweep() {
   constexpr int kBlock = 4096;
   const int nf = int(m_.n_faces());
@@ -242,7 +258,7 @@ void Remesher::final_sweep() {
       p.q_min = std::min(p.q_min, q);
       p.q_sum += q;
       ++p.faces;
-      if (q < kRepairBelow) p.slivers.emplace_back(q, f);
+      if (q < kRepairBelow && (!(opt_.incremental && opt_.changed) || near_change(f))) p.slivers.emplace_back(q, f);
       // Every operation refuses degenerate triangles and the repair removes those it can: one left
       // (a configuration no local operation repairs) is reported, never silently returned.
       const double longest2 = std::max({e0, e1, e2, hmin_ * hmin_});

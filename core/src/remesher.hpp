@@ -209,6 +209,7 @@ class Remesher {
   void work_edges(std::vector<EdgeHandle>& edges) const;
   void split_long_edges();
   std::size_t pass();
+  bool near_change(FaceHandle f) const;
   void final_sweep();
 
   bool split(EdgeHandle e);

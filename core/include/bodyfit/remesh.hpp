@@ -11,6 +11,7 @@
 // dihedral angles are not features of S).
 #include <bodyfit/mesh.hpp>
 
+#include <functional>
 #include <memory>
 
 namespace bodyfit {
@@ -39,6 +40,12 @@ struct RemeshOptions {
   /// Only work where needed: elements far from the interface that already satisfy the sizing and
   /// quality criteria are left untouched (the cost follows the part that changes).
   bool incremental = true;
+  /// With `incremental`: where the mesh may have changed since it was last remeshed with these
+  /// options (its caller knows: an evolution marks what each step's cut changes). Only poor
+  /// triangles and off-size edges with a vertex where it holds start the work; elsewhere the mesh
+  /// is as the last remesh left it, and what that remesh could not improve is not tried again.
+  /// Called from several threads at once. Empty (the default): anywhere.
+  std::function<bool(VertexHandle)> changed;
   /// The fixed surface S onto which new and moved vertices are projected; when null the input
   /// mesh itself is used as reference.
   std::shared_ptr<const ReferenceSurface> reference;
