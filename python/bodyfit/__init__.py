@@ -128,7 +128,8 @@ def _read_history(path: str, as_dataframe: bool):
         as_dataframe = False
     if as_dataframe:
         import pandas
-        return pandas.read_csv(path)
+        # pandas' default float parser may be off by an ulp: the values the file holds, exactly.
+        return pandas.read_csv(path, float_precision="round_trip")
     with open(path, newline="") as f:
         rows = list(_csv.reader(f))
     if not rows:
