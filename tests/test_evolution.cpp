@@ -9,16 +9,19 @@
 #include <bodyfit/io.hpp>
 #include <bodyfit/model_guard.hpp>
 #include <bodyfit/plugin_loader.hpp>
+#include <bodyfit/validate.hpp>
 
 #include "test_support.hpp"
 #include "thermal_fixtures.hpp"
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <numbers>
+#include <random>
 #include <sstream>
 
 using namespace bodyfit;
@@ -321,4 +324,72 @@ TEST_CASE("a nucleus's disk stays on its sheet of S: a thin wall's other face, n
   CHECK(inside == 25);  // the grid points of spacing 0.1 strictly within 0.3 of the centre
   CHECK_THROWS_AS(nucleus_level_set(slab, {int(slab.n_vertices()), rho}), InputError);
   CHECK_THROWS_AS(nucleus_level_set(slab, {centre, std::nan("")}), InputError);
+}
+
+namespace {
+
+/// G grows at unit normal speed; `remesh_everywhere` as its needs() say.
+class Spreading final : public VelocityModel {
+ public:
+  explicit Spreading(bool everywhere) : everywhere_(everywhere) {}
+  std::string_view name() const override { return "spreading"; }
+  void configure(Parameters&) override {}
+  VelocityField compute(const StepContext& context) override {
+    return VelocityField::normal(ScalarField(context.mesh().n_vertices(), 1.0));
+  }
+  ModelNeeds needs() const override { return {.remesh_everywhere = everywhere_}; }
+
+ private:
+  bool everywhere_;
+};
+
+double worst_quality_beyond(const SurfaceMesh& mesh, double x) {
+  double worst = 1;
+  for (auto f : mesh.faces()) {
+    auto [a, b, c] = face_points(mesh, f);
+    if ((a[0] + b[0] + c[0]) / 3 > x) worst = std::min(worst, triangle_quality(a, b, c));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("each step's remesh starts where the cut changed T^n, everywhere for a model that asks or a plugin before ABI 3.4") {
+  // Poor triangles far from the front, made after the set-up (vertices shuffled within the plane,
+  // x > 0.6; the disk of radius 0.3 grows by 0.1 in two steps): left as they are by a model of the
+  // front, repaired at the first step when every remesh looks everywhere.
+  struct Run {
+    double before = 0, after = 0, area = 0;
+  };
+  auto run = [](VelocityModel& model) {
+    CaseSetup setup = setup_case(parse_case(toml::parse(kPlane)));
+    setup.options.max_iterations = 2;
+    setup.options.dt = 0.05;
+    SurfaceMesh& mesh = setup.mesh;
+    const double h = mean_edge_length(mesh);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> noise(-0.38 * h, 0.38 * h);
+    for (auto v : mesh.vertices())
+      if (mesh.point(v)[0] > 0.6 && !mesh.is_boundary(v)) mesh.point(v) += Vec3(noise(random), noise(random), 0);
+    REQUIRE(validate_mesh(mesh).ok());
+    Run r;
+    r.before = worst_quality_beyond(mesh, 0.65);
+    const EvolutionResult result = evolve(mesh, model, setup.options, {}, EvolutionHooks::quiet());
+    REQUIRE(result.records.size() == 2);
+    r.after = worst_quality_beyond(mesh, 0.65);
+    r.area = region_area(mesh, kInside);
+    return r;
+  };
+  Spreading front(false), everywhere(true), older(false);
+  GuardedModel older_plugin(older, 0, (3u << 16) | 3u);
+  const Run a = run(front), b = run(everywhere), c = run(older_plugin);
+  INFO("worst quality beyond x = 0.65: " << a.before << " -> " << a.after << " (front), " << b.after << " (everywhere), "
+                                         << c.after << " (ABI 3.3)");
+  CHECK(a.before < 0.3);
+  CHECK(a.after == a.before);
+  CHECK(b.after > 0.5);
+  CHECK(c.after == b.after);
+  // The front is the same: what differs is far from it.
+  CHECK(a.area == doctest::Approx(kPi * 0.4 * 0.4).epsilon(0.02));
+  CHECK(b.area == doctest::Approx(a.area).epsilon(1e-6));
 }

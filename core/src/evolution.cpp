@@ -4,6 +4,7 @@
 #include <bodyfit/geometry.hpp>
 
 #include <bodyfit/band_advector.hpp>
+#include "blocks.hpp"
 #include "step_state.hpp"
 
 #include <fmt/format.h>
@@ -41,6 +42,37 @@ class Stopwatch {
 
  private:
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+/// What a step's cut changes in T^n, which is otherwise as the last remesh left it: G^n's boundary
+/// (its vertices lose their interface tags), what the front swept (d^n and φ^{n+1} of opposite
+/// signs: labels), and the new boundary (φ = 0: the cut's vertices, and those it snaps). Marked on
+/// T^n's vertices in a property of the mesh before the cut, so that they follow its renumbering,
+/// and asked by the remesh after it (RemeshOptions::changed); removed with this object.
+class ChangedVertices {
+ public:
+  ChangedVertices(SurfaceMesh& mesh, const ScalarField& distance, const ScalarField& phi_next) : mesh_(mesh) {
+    mesh_.add_property(changed_);
+    const int nv = int(mesh_.n_vertices());
+    const bool known = distance.size() == std::size_t(nv) && phi_next.size() == std::size_t(nv);
+    for_each_index(nv, [&](int i) {
+      const std::size_t v = std::size_t(i);
+      mesh_.property(changed_, VertexHandle(i)) = !known || (distance[v] < 0) != (phi_next[v] < 0);
+    });
+    for (auto e : mesh_.edges())
+      if (mesh_.interface(e))
+        for (int side : {0, 1}) mesh_.property(changed_, mesh_.to_vertex_handle(mesh_.halfedge_handle(e, side))) = 1;
+  }
+  ~ChangedVertices() { mesh_.remove_property(changed_); }
+  ChangedVertices(const ChangedVertices&) = delete;
+  ChangedVertices& operator=(const ChangedVertices&) = delete;
+
+  /// Vertices the cut adds start unmarked (the property's default): they lie on the new boundary.
+  bool operator()(VertexHandle v) const { return mesh_.property(changed_, v) || mesh_.phi(v) == 0; }
+
+ private:
+  SurfaceMesh& mesh_;
+  OpenMesh::VPropHandleT<char> changed_;
 };
 
 std::size_t count_inside(const SurfaceMesh& mesh) {
@@ -570,11 +602,17 @@ class Evolution {
     DiscretizeOptions cut = options_.discretize;
     if (cut.drop_detached)  // d^n on T^n: G^{n+1} grows from G^n (and the step's nuclei)
       cut.grown_from = step.nucleated.empty() ? std::span<const double>(distance_) : std::span<const double>(step.nucleated);
+    // The remesh looks for work only where the cut changed T^n, unless the model computes on the
+    // whole mesh (ModelNeeds::remesh_everywhere).
+    std::optional<ChangedVertices> changed;
+    if (!needs_.remesh_everywhere) changed.emplace(mesh_, distance_, step.phi_next);
     const DiscretizeReport report = discretize(mesh_, step.phi_next, cut);
     if (report.removed_detached > 0)
       spdlog::debug("n={}: {} part(s) of G detached from G^n given to the outside", n_ + 1, report.removed_detached);
     step.ms.discretize += clock.lap_ms();
-    remesh(mesh_, options_.remesh);
+    RemeshOptions remeshing = options_.remesh;
+    if (changed) remeshing.changed = [&](VertexHandle v) { return (*changed)(v); };
+    remesh(mesh_, remeshing);
     if (options_.canonical_order) canonicalize(mesh_);
     step.ms.remesh += clock.lap_ms();
     measure_distance();  // d^{n+1}: the review's and the next step's

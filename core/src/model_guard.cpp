@@ -184,6 +184,7 @@ void GuardedModel::configure(Parameters& parameters) {
 ModelNeeds GuardedModel::needs() const {
   ModelNeeds needs = guarded("needs", iteration_, [&] { return model_.needs(); });
   if (!plugin_has(abi_, kAbiBandNormals)) needs.whole_surface_distance = true;
+  if (!plugin_has(abi_, kAbiRemeshWhereChanged)) needs.remesh_everywhere = true;
   return needs;
 }
 

@@ -296,7 +296,8 @@ class ThermalModel final : public VelocityModel {
 
   // d everywhere: the shape gradient is extended over the whole skin, and nucleation looks for sites anywhere.
   ModelNeeds needs() const override {
-    return {.may_reject = true, .freeze_velocity = true, .whole_surface_distance = true};
+    // The state and adjoint are solved on the whole part: every triangle of its skin enters J.
+    return {.may_reject = true, .freeze_velocity = true, .whole_surface_distance = true, .remesh_everywhere = true};
   }
 
   VelocityField compute(const StepContext& context) override {

@@ -393,6 +393,7 @@ void PythonModel::adopt(py::object instance) {
   needs_.may_reject = py::getattr(instance_, "may_reject", py::bool_(false)).cast<bool>();
   needs_.freeze_velocity = py::getattr(instance_, "freeze_velocity", py::bool_(false)).cast<bool>();
   needs_.whole_surface_distance = py::getattr(instance_, "whole_surface_distance", py::bool_(false)).cast<bool>();
+  needs_.remesh_everywhere = py::getattr(instance_, "remesh_everywhere", py::bool_(false)).cast<bool>();
   state_version_ = py::getattr(instance_, "state_version", py::int_(0)).cast<std::uint32_t>();
 }
 

@@ -18,7 +18,7 @@
 namespace bodyfit {
 
 inline constexpr std::uint32_t kPluginAbiMajor = 3;
-inline constexpr std::uint32_t kPluginAbiMinor = 3;
+inline constexpr std::uint32_t kPluginAbiMinor = 4;
 inline constexpr std::uint32_t kPluginAbi = (kPluginAbiMajor << 16) | kPluginAbiMinor;
 
 /// A feature of the plugin interface and the ABI version that brought it.
@@ -49,6 +49,11 @@ inline constexpr AbiFeature kAbiBandedDistance{3, 2, "banded distance"};
 /// StepContext::band_vertices(), and surface_normals() filled there only in a banded state: a model
 /// built before it (which may read S's normals anywhere) gets d on the whole surface.
 inline constexpr AbiFeature kAbiBandNormals{3, 3, "band normals"};
+
+// The features of ABI 3.4.
+/// ModelNeeds::remesh_everywhere: a model built before it gets each remesh looking everywhere (as
+/// every remesh did then: its needs() returns the shorter struct).
+inline constexpr AbiFeature kAbiRemeshWhereChanged{3, 4, "remesh where changed"};
 
 /// Whether a plugin built for `abi` has `feature`.
 constexpr bool plugin_has(std::uint32_t abi, AbiFeature feature) {

@@ -199,6 +199,11 @@ struct ModelNeeds {
   /// Otherwise (EvolutionOptions::narrow_band) the driver computes d^n only within a band of Σ
   /// that holds what the step can reach: beyond it d is ±the band's width (sign right).
   bool whole_surface_distance = false;
+  /// The model computes on the whole mesh (a PDE on the part it bounds): each remesh looks for
+  /// poor triangles everywhere. Otherwise it starts work only where the step's cut changed T^n
+  /// (G^n's boundary, what the front swept, the new boundary; RemeshOptions::changed), and what
+  /// the last remesh left elsewhere is not tried again.
+  bool remesh_everywhere = false;
 };
 
 /// A model's verdict on a candidate T^{n+1}.
