@@ -2,6 +2,7 @@
 // file in memory, GMF binaries): bit-exact round trips, GMF binaries built here byte by byte
 // (expected values come from how the bytes were built), and damaged files refused with an
 // InputError naming the file and the line or byte.
+#include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/generators.hpp>
 #include <bodyfit/io.hpp>
@@ -19,6 +20,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include <sys/stat.h>
 
 using namespace bodyfit;
 using bodyfit::test::TempDir;
@@ -311,6 +314,30 @@ TEST_CASE(".meshb: write -> read is bit-exact with refs, regions, interface, rid
   // The text and binary paths agree.
   write_mesh(mesh, dir / "a.mesh");
   check_same_mesh(read_mesh(dir / "a.mesh"), back);
+}
+
+TEST_CASE("a write with its size announced: exactly the bytes written, over a bigger file, no blocks kept past the end") {
+  TempDir dir("io-fast-announced");
+  const fs::path file = dir / "f.bin";
+  const std::string big(3'000'000, 'a'), small(100'000, 'b');
+  auto write = [&](const std::string& bytes, std::uint64_t announced) {
+    write_atomically(file, [&](std::ostream& out) { out.write(bytes.data(), std::streamsize(bytes.size())); },
+                     announced);
+  };
+  write(big, big.size());
+  CHECK(test::read_file(file) == big);
+  // Announced 30 times what is written: the file is what was written, and the blocks allocated
+  // for the rest are given back (st_blocks counts 512-byte units).
+  write(small, 30 * small.size());
+  CHECK(test::read_file(file) == small);
+  struct stat st {};
+  REQUIRE(::stat(file.c_str(), &st) == 0);
+  CHECK(std::uint64_t(st.st_size) == small.size());
+  CHECK(std::uint64_t(st.st_blocks) * 512 < 2 * small.size());
+  // Announced less than is written: the file grows past the announcement.
+  write(big, small.size());
+  CHECK(test::read_file(file) == big);
+  for (const auto& entry : fs::directory_iterator(dir.path())) CHECK_FALSE(is_atomic_temporary(entry.path().filename().string()));
 }
 
 TEST_CASE(".meshb and .solb built byte by byte: versions 1 to 4, both byte orders") {

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <regex>
 #include <system_error>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace bodyfit {
@@ -33,9 +34,21 @@ void write_atomically_at(const std::filesystem::path& target,
   }
 }
 
-void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write) {
+void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write,
+                      std::uint64_t expected_bytes) {
   write_atomically_at(target, [&](const std::filesystem::path& temp) {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    auto mode = std::ios::binary | std::ios::trunc;
+    if (expected_bytes > 0) {
+      // Linux's fallocate, not posix_fallocate: where the filesystem cannot allocate, the latter
+      // writes zeros instead. Any failure (no space, a file-size limit) shows again at the write.
+      const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+      if (fd >= 0) {
+        if (::fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, off_t(expected_bytes)) == 0)
+          mode = std::ios::binary | std::ios::in | std::ios::out;  // keep the blocks: no truncation
+        ::close(fd);
+      }
+    }
+    std::ofstream out(temp, mode);
     if (!out)
       throw write_error(target, fmt::format("cannot write in {} ({})", temp.parent_path().string(), std::strerror(errno)));
     errno = 0;  // what the failing write(2) leaves: ENOSPC, EFBIG (a file-size limit), EIO…
@@ -44,6 +57,11 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
     if (!out) {
       const int error = errno;
       throw write_error(target, fmt::format("write failed ({})", error ? std::strerror(error) : "disk full?"));
+    }
+    // Blocks allocated past what was written are given back (a truncation to the same size does).
+    if (expected_bytes > 0 && std::uint64_t(out.tellp()) < expected_bytes) {
+      std::error_code ec;
+      std::filesystem::resize_file(temp, std::uint64_t(out.tellp()), ec);
     }
   });
 }

@@ -7,6 +7,8 @@
 #include <bodyfit/io.hpp>
 
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -261,10 +263,15 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
 
   SurfaceMesh mesh;
   mesh.reserve(r.points.size(), r.points.size() + r.triangles.size(), r.triangles.size());
-  for (std::size_t i = 0; i < r.points.size(); ++i) {
-    auto v = mesh.add_vertex(r.points[i]);
-    mesh.vertex_ref(v) = i < r.vertex_refs.size() ? r.vertex_refs[i] : 0;
-  }
+  // The vertices at once (add_vertex grows every vertex property by one, vertex after vertex).
+  mesh.resize(r.points.size(), 0, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.points.size(), 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const auto v = VertexHandle(int(i));
+      mesh.set_point(v, r.points[i]);
+      mesh.vertex_ref(v) = i < r.vertex_refs.size() ? r.vertex_refs[i] : 0;
+    }
+  });
   // The connectivity in a few array passes; triangle by triangle only to say what is wrong.
   if (build_connectivity(mesh, {r.triangles.data(), r.triangles.size()})) {
     for (std::size_t t = 0; t < r.triangles.size() && t < r.triangle_refs.size(); ++t)

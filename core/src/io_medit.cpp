@@ -6,8 +6,10 @@
 #include <bodyfit/guards.hpp>
 
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string_view>
@@ -258,36 +260,53 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   return r;
 }
 
-/// What a Medit writer writes: vertices, triangles, and the edges MMG must keep.
+/// What a Medit writer writes besides the vertices and triangles: the edges MMG must keep, the
+/// lists of tags, and the vertices' numbers where deleted vertices leave gaps.
 struct MeditContent {
-  std::vector<std::int64_t> vertex_index;  // by vertex idx, -1 for deleted
-  std::vector<VertexHandle> vertices;
-  std::vector<FaceHandle> faces;
+  std::vector<std::int64_t> renumbered;  // by vertex idx, -1 for deleted; empty: a vertex's number is its idx
+  std::size_t vertices = 0, faces = 0;
   std::vector<EdgeHandle> edges;  // interface, ridge, required, non-zero ref or boundary
   std::vector<std::int64_t> corners, required_vertices, ridges, required_edges;  // 1-based
+  std::int64_t number(VertexHandle v) const {  // 1-based
+    return (renumbered.empty() ? std::int64_t(v.idx()) : renumbered[std::size_t(v.idx())]) + 1;
+  }
 };
 
 MeditContent collect(const SurfaceMesh& mesh) {
   MeditContent c;
-  c.vertex_index = vertex_numbering(mesh);
-  c.vertices.reserve(mesh.n_vertices());
+  for ([[maybe_unused]] auto v : mesh.vertices()) ++c.vertices;
+  for ([[maybe_unused]] auto f : mesh.faces()) ++c.faces;
+  if (c.vertices < mesh.n_vertices()) c.renumbered = vertex_numbering(mesh);  // deleted vertices leave gaps
   for (auto v : mesh.vertices()) {
-    c.vertices.push_back(v);
-    const auto number = c.vertex_index[v.idx()] + 1;
-    if (mesh.corner(v)) c.corners.push_back(number);
-    if (mesh.required(v)) c.required_vertices.push_back(number);
+    if (mesh.corner(v)) c.corners.push_back(c.number(v));
+    if (mesh.required(v)) c.required_vertices.push_back(c.number(v));
   }
-  c.faces.reserve(mesh.n_faces());
-  for (auto f : mesh.faces()) c.faces.push_back(f);
-  for (auto e : mesh.edges()) {
-    if (!(mesh.interface(e) || mesh.ridge(e) || mesh.required(e) || mesh.edge_ref(e) != 0 || mesh.is_boundary(e)))
-      continue;
-    c.edges.push_back(e);
-    const auto number = std::int64_t(c.edges.size());
-    if (mesh.ridge(e)) c.ridges.push_back(number);
-    if (mesh.required(e)) c.required_edges.push_back(number);
+  // The edges in blocks, in parallel (five tests per edge, over every edge), then in order.
+  constexpr int kBlock = 16384;
+  const int ne = int(mesh.n_edges()), blocks = (ne + kBlock - 1) / kBlock;
+  std::vector<std::vector<EdgeHandle>> found(std::size_t(std::max(blocks, 0)));
+  tbb::parallel_for(0, blocks, [&](int b) {
+    for (int i = b * kBlock; i < std::min(ne, (b + 1) * kBlock); ++i) {
+      const EdgeHandle e(i);
+      if (!mesh.status(e).deleted() && (mesh.interface(e) || mesh.ridge(e) || mesh.required(e) ||
+                                        mesh.edge_ref(e) != 0 || mesh.is_boundary(e)))
+        found[std::size_t(b)].push_back(e);
+    }
+  });
+  for (const auto& block : found) c.edges.insert(c.edges.end(), block.begin(), block.end());
+  for (std::size_t i = 0; i < c.edges.size(); ++i) {
+    if (mesh.ridge(c.edges[i])) c.ridges.push_back(std::int64_t(i) + 1);
+    if (mesh.required(c.edges[i])) c.required_edges.push_back(std::int64_t(i) + 1);
   }
   return c;
+}
+
+/// A triangle's corners in the order fv_range gives them (from the face's halfedge), 1-based.
+std::array<std::int64_t, 3> corner_numbers(const SurfaceMesh& mesh, const MeditContent& c, FaceHandle f) {
+  auto h = mesh.halfedge_handle(f);
+  const auto v0 = mesh.to_vertex_handle(h);
+  h = mesh.next_halfedge_handle(h);
+  return {c.number(v0), c.number(mesh.to_vertex_handle(h)), c.number(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)))};
 }
 
 int written_edge_ref(const SurfaceMesh& mesh, EdgeHandle e) {
@@ -297,23 +316,18 @@ int written_edge_ref(const SurfaceMesh& mesh, EdgeHandle e) {
 void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostream& stream) {
   OutputBuffer out(stream);
   out.text("MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n");
-  out.integer(std::int64_t(c.vertices.size()));
+  out.integer(std::int64_t(c.vertices));
   out.put('\n');
-  for (auto v : c.vertices) {
+  for (auto v : mesh.vertices()) {
     const auto& p = mesh.point(v);
     out.real(p[0]), out.put(' '), out.real(p[1]), out.put(' '), out.real(p[2]), out.put(' ');
     out.integer(mesh.vertex_ref(v)), out.put('\n');
   }
   out.text("\nTriangles\n");
-  out.integer(std::int64_t(c.faces.size()));
+  out.integer(std::int64_t(c.faces));
   out.put('\n');
-  for (auto f : c.faces) {
-    auto h = mesh.halfedge_handle(f);
-    auto v0 = mesh.to_vertex_handle(h);
-    h = mesh.next_halfedge_handle(h);
-    auto v1 = mesh.to_vertex_handle(h);
-    auto v2 = mesh.to_vertex_handle(mesh.next_halfedge_handle(h));
-    for (auto v : {v0, v1, v2}) out.integer(c.vertex_index[v.idx()] + 1), out.put(' ');
+  for (auto f : mesh.faces()) {
+    for (auto number : corner_numbers(mesh, c, f)) out.integer(number), out.put(' ');
     out.integer(mesh.region(f)), out.put('\n');
   }
   if (!c.edges.empty()) {
@@ -322,8 +336,8 @@ void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostre
     out.put('\n');
     for (auto e : c.edges) {
       auto h = mesh.halfedge_handle(e, 0);
-      out.integer(c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1), out.put(' ');
-      out.integer(c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1), out.put(' ');
+      out.integer(c.number(mesh.from_vertex_handle(h))), out.put(' ');
+      out.integer(c.number(mesh.to_vertex_handle(h))), out.put(' ');
       out.integer(written_edge_ref(mesh, e)), out.put('\n');
     }
   }
@@ -341,27 +355,37 @@ void write_medit_text(const SurfaceMesh& mesh, const MeditContent& c, std::ostre
   out.flush();
 }
 
-void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, std::ostream& stream) {
-  const std::uint64_t estimate = c.vertices.size() * 28 + c.faces.size() * 16 + c.edges.size() * 12 + 4096;
-  const BinaryFormat format = binary_format_for(estimate);
+/// The binary format of a mesh, and a bound on its file's size (within a few bytes per keyword).
+std::pair<BinaryFormat, std::uint64_t> binary_layout(const MeditContent& c) {
+  const auto lists = c.ridges.size() + c.required_edges.size() + c.corners.size() + c.required_vertices.size();
+  auto bytes = [&](std::uint64_t int_size) {
+    return 8 + 10 * (12 + int_size) + c.vertices * (24 + int_size) + c.faces * 4 * int_size +
+           c.edges.size() * 3 * int_size + lists * int_size;
+  };
+  const BinaryFormat format = binary_format_for(bytes(4));
+  return {format, bytes(format.int_size())};
+}
+
+void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, const BinaryFormat& format,
+                        std::ostream& stream) {
   OutputBuffer out(stream);
   BinaryKeywordWriter w(out, format);
   const std::uint64_t is = format.int_size();
   w.begin(kDimension, 4);
   out.binary<std::int32_t>(3);
-  w.begin(kVertices, is + c.vertices.size() * (24 + is));
-  w.count(std::int64_t(c.vertices.size()));
-  for (auto v : c.vertices) {
+  w.begin(kVertices, is + c.vertices * (24 + is));
+  w.count(std::int64_t(c.vertices));
+  for (auto v : mesh.vertices()) {
     const auto& p = mesh.point(v);
     w.real(p[0]);
     w.real(p[1]);
     w.real(p[2]);
     w.integer(mesh.vertex_ref(v));
   }
-  w.begin(kTriangles, is + c.faces.size() * 4 * is);
-  w.count(std::int64_t(c.faces.size()));
-  for (auto f : c.faces) {
-    for (auto v : mesh.fv_range(f)) w.integer(c.vertex_index[v.idx()] + 1);
+  w.begin(kTriangles, is + c.faces * 4 * is);
+  w.count(std::int64_t(c.faces));
+  for (auto f : mesh.faces()) {
+    for (auto number : corner_numbers(mesh, c, f)) w.integer(number);
     w.integer(mesh.region(f));
   }
   if (!c.edges.empty()) {
@@ -369,8 +393,8 @@ void write_medit_binary(const SurfaceMesh& mesh, const MeditContent& c, std::ost
     w.count(std::int64_t(c.edges.size()));
     for (auto e : c.edges) {
       auto h = mesh.halfedge_handle(e, 0);
-      w.integer(c.vertex_index[mesh.from_vertex_handle(h).idx()] + 1);
-      w.integer(c.vertex_index[mesh.to_vertex_handle(h).idx()] + 1);
+      w.integer(c.number(mesh.from_vertex_handle(h)));
+      w.integer(c.number(mesh.to_vertex_handle(h)));
       w.integer(written_edge_ref(mesh, e));
     }
   }
@@ -401,12 +425,12 @@ SurfaceMesh read_medit(const fs::path& file, const ReadOptions& options) {
 
 void write_medit(const SurfaceMesh& mesh, const fs::path& file, bool binary) {
   const MeditContent content = collect(mesh);
-  write_atomically(file, [&](std::ostream& out) {
-    if (binary)
-      write_medit_binary(mesh, content, out);
-    else
-      write_medit_text(mesh, content, out);
-  });
+  if (binary) {
+    const auto [format, bytes] = binary_layout(content);
+    write_atomically(file, [&](std::ostream& out) { write_medit_binary(mesh, content, format, out); }, bytes);
+  } else {
+    write_atomically(file, [&](std::ostream& out) { write_medit_text(mesh, content, out); });
+  }
 }
 
 }  // namespace bodyfit::io_detail

@@ -177,7 +177,10 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
                                          f.dimension));
     types.push_back(io_detail::solution_type_of(f.dimension, file));
   }
-  write_atomically(file, [&](std::ostream& stream) {
+  std::uint64_t per_vertex = 0;
+  for (const auto& f : fields) per_vertex += std::uint64_t(f.dimension);
+  const std::uint64_t binary_bytes = n * per_vertex * 8 + 4 * fields.size() + 1024;  // a bound
+  auto write = [&](std::ostream& stream) {
     io_detail::OutputBuffer out(stream);
     if (ext == ".sol") {
       out.text("MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n");
@@ -197,9 +200,7 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
       }
       out.text("\nEnd\n");
     } else {
-      std::uint64_t per_vertex = 0;
-      for (const auto& f : fields) per_vertex += std::uint64_t(f.dimension);
-      const auto format = io_detail::binary_format_for(n * per_vertex * 8 + 1024);
+      const auto format = io_detail::binary_format_for(binary_bytes);
       io_detail::BinaryKeywordWriter w(out, format);
       w.begin(io_detail::kDimension, 4);
       out.binary<std::int32_t>(3);
@@ -214,7 +215,8 @@ void write_sol(const std::filesystem::path& file, const std::vector<SolField>& f
       w.begin(io_detail::kEnd, 0);
     }
     out.flush();
-  });
+  };
+  write_atomically(file, write, ext == ".solb" ? binary_bytes : 0);
 }
 
 ScalarField read_scalar_sol(const std::filesystem::path& file, std::size_t expected_vertices) {
