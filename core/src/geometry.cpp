@@ -148,23 +148,26 @@ VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u) {
 
 VectorField vertex_gradients(const SurfaceMesh& mesh, const ScalarField& u, std::span<const int> vertices) {
   VectorField result(mesh.n_vertices(), Vec3(0, 0, 0));
-  std::vector<FaceHandle> faces;
-  CornerShare share;
-  for (int i : vertices) {
-    const VertexHandle v(i);
-    faces.clear();
-    for (FaceHandle f : mesh.vf_range(v)) faces.push_back(f);
-    std::sort(faces.begin(), faces.end());  // the scatter's order: by face index
-    Vec3 sum(0, 0, 0), normal(0, 0, 0);
-    double weight = 0;
-    for (FaceHandle f : faces) {
-      if (!corner_share(mesh, f, u, share)) continue;
-      sum += share.weighted_gradient;
-      normal += share.normal;
-      weight += share.twice_area;
+  // Each vertex on its own (in parallel: a front's band is thousands of vertices at every sub-step).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices.size(), 256), [&](const auto& range) {
+    std::vector<FaceHandle> faces;
+    CornerShare share;
+    for (std::size_t k = range.begin(); k < range.end(); ++k) {
+      const VertexHandle v(vertices[k]);
+      faces.clear();
+      for (FaceHandle f : mesh.vf_range(v)) faces.push_back(f);
+      std::sort(faces.begin(), faces.end());  // the scatter's order: by face index
+      Vec3 sum(0, 0, 0), normal(0, 0, 0);
+      double weight = 0;
+      for (FaceHandle f : faces) {
+        if (!corner_share(mesh, f, u, share)) continue;
+        sum += share.weighted_gradient;
+        normal += share.normal;
+        weight += share.twice_area;
+      }
+      result[std::size_t(v.idx())] = averaged_tangent_gradient(sum, normal, weight);
     }
-    result[std::size_t(i)] = averaged_tangent_gradient(sum, normal, weight);
-  }
+  });
   return result;
 }
 

@@ -21,6 +21,8 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -425,20 +427,29 @@ class FireModel final : public VelocityModel {
       return rate * n + slope * t;
     };
     // A sub-step in a narrow band needs R at the band's vertices only, and no metrics or fields.
+    // (Each vertex on its own: in parallel.)
     if (!active.empty()) {
       if (rates_.size() != mesh.n_vertices()) rates_.assign(mesh.n_vertices(), 0.0);
-      for (int v : active) speed[v] = rates_[std::size_t(v)] = rate_at(v);
-      if (huygens_) {
-        VectorField velocity(mesh.n_vertices(), Vec3(0, 0, 0));
-        for (int v : active) velocity[v] = huygens_at(v, speed[v]);
-        return VelocityField::tangential(std::move(velocity));
-      }
+      VectorField velocity(huygens_ ? mesh.n_vertices() : 0, Vec3(0, 0, 0));
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, active.size(), 128), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k < range.end(); ++k) {
+          const int v = active[k];
+          speed[v] = rates_[std::size_t(v)] = rate_at(v);
+          if (huygens_) velocity[v] = huygens_at(v, speed[v]);
+        }
+      });
+      if (huygens_) return VelocityField::tangential(std::move(velocity));
       return VelocityField::normal(std::move(speed));
     }
-    if (band.empty())
-      for (auto v : mesh.vertices()) speed[v.idx()] = rate_at(v.idx());
-    else
-      for (int v : band) speed[v] = rate_at(v);
+    auto over_band = [&](auto&& visit) {
+      const std::size_t n = band.empty() ? mesh.n_vertices() : band.size();
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k < range.end(); ++k)
+          if (!band.empty()) visit(band[k]);
+          else if (!mesh.status(VertexHandle(int(k))).deleted()) visit(int(k));
+      });
+    };
+    over_band([&](int v) { speed[v] = rate_at(v); });
     rates_ = speed;  // the state's own compute: the rates the arrival raster records in its steps
     clock_start_ = context.clock_start();
     if (context.is_height_field()) record_perimeter(context);
@@ -447,10 +458,7 @@ class FireModel final : public VelocityModel {
     if (huygens_) {
       field.kind = VelocityField::Kind::Tangential;
       field.vector.assign(mesh.n_vertices(), Vec3(0, 0, 0));
-      if (band.empty())
-        for (auto v : mesh.vertices()) field.vector[v.idx()] = huygens_at(v.idx(), speed[v.idx()]);
-      else
-        for (int v : band) field.vector[v] = huygens_at(v, speed[v]);
+      over_band([&](int v) { field.vector[v] = huygens_at(v, speed[v]); });
     }
     // Rate of spread on the front: vertices of interface edges.
     double lo = std::numeric_limits<double>::infinity(), hi = 0, sum = 0;
