@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -194,10 +196,11 @@ void RothermelSpread::update(const SurfaceMesh& mesh, const VectorField& normals
     spreads_[i] = crown.spread;
     types_[i] = double(crown.type);
   };
-  if (!active.empty())
-    for (int v : active) update_vertex(v);
-  else
-    for (int v = 0; v < int(n); ++v) update_vertex(v);
+  // Each vertex on its own: in parallel.
+  const std::size_t count = active.empty() ? n : active.size();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 128), [&](const auto& range) {
+    for (std::size_t k = range.begin(); k < range.end(); ++k) update_vertex(active.empty() ? int(k) : active[k]);
+  });
 }
 
 // Byram's fireline intensity, flame length and the heat per unit area of the cells that burnt
