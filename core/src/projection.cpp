@@ -10,6 +10,8 @@
 #include <memory>
 #include <numeric>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 namespace bodyfit {
@@ -219,13 +221,15 @@ std::shared_ptr<ReferenceSurface> ReferenceSurface::sphere(const Vec3& center, d
 void ReferenceSurface::ensure_tree() const {
   std::call_once(tree_once_, [this] {
     std::vector<Vec3> lo(tri_.size()), hi(tri_.size());
-    for (std::size_t i = 0; i < tri_.size(); ++i) {
-      lo[i] = hi[i] = points_[tri_[i][0]];
-      for (int k = 1; k < 3; ++k) {
-        lo[i].minimize(points_[tri_[i][k]]);
-        hi[i].maximize(points_[tri_[i][k]]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tri_.size(), 4096), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) {
+        lo[i] = hi[i] = points_[tri_[i][0]];
+        for (int k = 1; k < 3; ++k) {
+          lo[i].minimize(points_[tri_[i][k]]);
+          hi[i].maximize(points_[tri_[i][k]]);
+        }
       }
-    }
+    });
     tree_ = std::make_unique<detail::BoxTree>();
     tree_->build(lo, hi);
   });

@@ -320,6 +320,7 @@ RemeshReport Remesher::run() {
   auto start = std::chrono::steady_clock::now();
   setup_sizes();
   ref_ = opt_.reference ? opt_.reference : std::make_shared<const ReferenceSurface>(m_);
+  ref_->prepare();  // before the sweeps that query it from every thread
   // Not needed where no chord the passes may make (up to twice hmax) can stray beyond hausd/2 from S
   // (a fine tessellation of a smooth surface, a plane): the checks' projections cost a third of a
   // remesh.
@@ -342,6 +343,7 @@ RemeshReport Remesher::run() {
                  double(cpu.tv_sec) * 1e3 + double(cpu.tv_nsec) * 1e-6 - cpu0, work_.size(), report_.splits,
                  report_.collapses, report_.flips, report_.relocations, usage.ru_minflt);
   };
+  stamp("reference");
   classify_features();
   stamp("features");
   compute_sizing();

@@ -39,6 +39,11 @@ class ReferenceSurface {
   /// The same at a point closest() returned.
   Vec3 smooth_normal(const SurfacePoint& q) const;
   bool analytic() const { return is_sphere_; }
+  /// Build the search tree now, with every thread. Otherwise the first query builds it, and the
+  /// threads of a parallel sweep that query at the same time wait for it, idle.
+  void prepare() const {
+    if (!is_sphere_) ensure_tree();
+  }
   /// Radius of the analytic sphere (0 for a triangle reference).
   double sphere_radius() const { return is_sphere_ ? radius_ : 0.0; }
   std::size_t n_triangles() const { return tri_.size(); }
