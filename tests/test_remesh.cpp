@@ -13,9 +13,11 @@
 #include <bodyfit/self_intersections.hpp>
 #include <bodyfit/validate.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include "test_support.hpp"
@@ -926,6 +928,38 @@ TEST_CASE("ReferenceSurface::max_curvature: 1/R on a fine sphere, 0 on a plane, 
   const ReferenceSurface cube(make_cube(4));  // 90° creases between triangles 0.5 / 3 · √5 apart at most
   CHECK(cube.max_curvature() > 3);
   CHECK(ReferenceSurface::sphere(Vec3(0, 0, 0), 4)->max_curvature() == 0.25);
+}
+
+TEST_CASE("self-intersections near some faces: exactly the pairs of the whole search that have one of them, and a limit that stops early") {
+  // Two spheres crossing along a circle, as one surface.
+  SurfaceMesh one = make_sphere({.faces = 2000});
+  SurfaceMesh two = one;
+  std::vector<VertexHandle> copy;
+  for (auto v : one.vertices()) copy.push_back(two.add_vertex(one.point(v) + Vec3(0.9, 0.2, 0.1)));
+  for (auto f : one.faces()) {
+    std::vector<VertexHandle> corners;
+    for (auto v : one.fv_range(f)) corners.push_back(copy[std::size_t(v.idx())]);
+    two.add_face(corners);
+  }
+  const auto all = self_intersections(two);
+  REQUIRE(all.size() > 100);
+  CHECK(std::is_sorted(all.begin(), all.end()));
+  for (int stride : {1, 3, 7}) {
+    CAPTURE(stride);
+    std::vector<int> faces;
+    for (int f = 0; f < int(two.n_faces()); f += stride) faces.push_back(f);
+    std::vector<std::pair<int, int>> expected;
+    for (const auto& [f, g] : all)
+      if (f % stride == 0 || g % stride == 0) expected.push_back({f, g});
+    CHECK(self_intersections_near(two, faces) == expected);
+  }
+  // A patch of one sphere only (its first 200 faces): no pair without one of them.
+  std::vector<int> patch(200);
+  std::iota(patch.begin(), patch.end(), 0);
+  for (const auto& pair : self_intersections_near(two, patch)) CHECK((pair.first < 200 || pair.second < 200));
+  const auto first = self_intersections(two, 1);
+  REQUIRE(first.size() == 1);
+  CHECK(std::binary_search(all.begin(), all.end(), first.front()));
 }
 
 TEST_CASE("self-intersections of a creased part are looked for, and those no operation separates are reported") {

@@ -7,7 +7,13 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 
 namespace bodyfit {
 
@@ -153,7 +159,9 @@ std::uint64_t cell_key(std::int64_t i, std::int64_t j, std::int64_t k) {
 namespace {
 
 /// The crossing pairs, all of them (near == nullptr) or those with a face flagged in `near` (by face
-/// index): the other faces then enter only the grid cells the flagged ones occupy.
+/// index): the other faces then enter only the grid cells the flagged ones occupy, and only those
+/// that do are made into Triangles (a remesh checks the few thousand faces it changed, not the
+/// whole surface: building a record per face was most of the cost).
 std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, const std::vector<char>* near,
                                                 std::size_t limit) {
   std::vector<std::pair<int, int>> found;
@@ -161,50 +169,94 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
   auto box = bounding_box(surface);
   double diagonal = (box.max - box.min).norm();
   double tol = 1e-10 * diagonal;
+  const int nf = int(surface.n_faces());
+  auto is_flagged = [&](int f) { return !near || (std::size_t(f) < near->size() && (*near)[std::size_t(f)]); };
+  auto corners = [&](int f) {
+    const auto vs = face_vertices(surface, FaceHandle(f));
+    return std::array<Vec3, 3>{surface.point(vs[0]), surface.point(vs[1]), surface.point(vs[2])};
+  };
+  auto bounds = [&](const std::array<Vec3, 3>& p, Vec3& lo, Vec3& hi) {
+    lo = hi = p[0];
+    for (int i = 1; i < 3; ++i) lo.minimize(p[i]), hi.maximize(p[i]);
+    lo -= Vec3(tol, tol, tol);
+    hi += Vec3(tol, tol, tol);
+  };
+  // The cell: about twice the mean edge, a few triangles per cell on a well-spread mesh (summed in
+  // fixed blocks: the same for any number of threads).
+  constexpr int kBlock = 4096;
+  const int blocks = (nf + kBlock - 1) / kBlock;
+  std::vector<double> edge_sums(std::size_t(blocks), 0.0);
+  std::vector<int> live_counts(std::size_t(blocks), 0);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    for (int f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
+      if (surface.status(FaceHandle(f)).deleted()) continue;
+      const auto p = corners(f);
+      edge_sums[std::size_t(b)] += (p[1] - p[0]).norm() + (p[2] - p[1]).norm() + (p[0] - p[2]).norm();
+      ++live_counts[std::size_t(b)];
+    }
+  });
+  double edge_sum = 0;
+  int live = 0;
+  for (int b = 0; b < blocks; ++b) edge_sum += edge_sums[std::size_t(b)], live += live_counts[std::size_t(b)];
+  if (live < 2) return found;
+  const double cell = std::max(2 * edge_sum / (3.0 * double(live)), diagonal * 1e-6);
+  auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
+  auto for_cells = [&](const Vec3& lo, const Vec3& hi, auto&& visit) {
+    for (auto i = index(lo[0], box.min[0]); i <= index(hi[0], box.min[0]); ++i)
+      for (auto j = index(lo[1], box.min[1]); j <= index(hi[1], box.min[1]); ++j)
+        for (auto k = index(lo[2], box.min[2]); k <= index(hi[2], box.min[2]); ++k) visit(cell_key(i, j, k));
+  };
 
   std::vector<Triangle> tris;
-  std::vector<int> face_of;  // the face index of each triangle (deleted faces are skipped)
+  std::vector<int> face_of;   // the face of each triangle
   std::vector<char> flagged;  // the triangle's face is one of `near`
-  tris.reserve(surface.n_faces());
-  double edge_sum = 0;
-  for (auto f : surface.faces()) {
+  auto add = [&](int f) {
     Triangle t;
-    auto vs = face_vertices(surface, f);
+    const auto vs = face_vertices(surface, FaceHandle(f));
     for (int i = 0; i < 3; ++i) t.v[i] = vs[i].idx(), t.p[i] = surface.point(vs[i]);
-    Vec3 n = OpenMesh::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-    double len = n.norm();
+    const Vec3 n = OpenMesh::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+    const double len = n.norm();
     t.normal = len > 0 ? n / len : Vec3(0, 0, 0);
-    t.lo = t.hi = t.p[0];
-    for (int i = 1; i < 3; ++i) t.lo.minimize(t.p[i]), t.hi.maximize(t.p[i]);
-    t.lo -= Vec3(tol, tol, tol);
-    t.hi += Vec3(tol, tol, tol);
-    edge_sum += (t.p[1] - t.p[0]).norm() + (t.p[2] - t.p[1]).norm() + (t.p[0] - t.p[2]).norm();
+    bounds(t.p, t.lo, t.hi);
     tris.push_back(t);
-    face_of.push_back(f.idx());
-    flagged.push_back(!near || (std::size_t(f.idx()) < near->size() && (*near)[std::size_t(f.idx())]));
-  }
-  // A uniform grid of cells about twice the mean edge: a few triangles per cell on a well-spread
-  // mesh. Each pair is tested once, in the cell holding the lower corner of their boxes' overlap.
-  double cell = std::max(2 * edge_sum / (3.0 * double(tris.size())), diagonal * 1e-6);
-  auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
+    face_of.push_back(f);
+    flagged.push_back(is_flagged(f));
+  };
+  // Each pair is tested once, in the cell holding the lower corner of their boxes' overlap. The
+  // flagged triangles first; then the others, into the cells the flagged ones occupy only (found in
+  // parallel, added in face order).
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
-  grid.reserve(tris.size() * 2);
-  // The flagged triangles first; then the others, into the cells the flagged ones occupy only.
-  for (int pass = 0; pass < 2; ++pass)
-    for (int f = 0; f < int(tris.size()); ++f) {
-      if (bool(flagged[std::size_t(f)]) != (pass == 0)) continue;
-      const auto& t = tris[std::size_t(f)];
-      for (auto i = index(t.lo[0], box.min[0]); i <= index(t.hi[0], box.min[0]); ++i)
-        for (auto j = index(t.lo[1], box.min[1]); j <= index(t.hi[1], box.min[1]); ++j)
-          for (auto k = index(t.lo[2], box.min[2]); k <= index(t.hi[2], box.min[2]); ++k) {
-            if (pass == 0) {
-              grid[cell_key(i, j, k)].push_back(f);
-            } else if (auto it = grid.find(cell_key(i, j, k)); it != grid.end()) {
-              it->second.push_back(f);
-            }
-          }
-    }
-  for (const auto& [key, members] : grid) {
+  for (int f = 0; f < nf; ++f) {
+    if (surface.status(FaceHandle(f)).deleted() || !is_flagged(f)) continue;
+    add(f);
+    const Triangle& t = tris.back();
+    const int id = int(tris.size()) - 1;
+    for_cells(t.lo, t.hi, [&](std::uint64_t key) { grid[key].push_back(id); });
+  }
+  if (near) {
+    std::vector<std::vector<int>> meeting(static_cast<std::size_t>(blocks));
+    tbb::parallel_for(0, blocks, [&](int b) {
+      for (int f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
+        if (surface.status(FaceHandle(f)).deleted() || is_flagged(f)) continue;
+        Vec3 lo, hi;
+        bounds(corners(f), lo, hi);
+        bool meets = false;
+        for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || grid.count(key) > 0; });
+        if (meets) meeting[std::size_t(b)].push_back(f);
+      }
+    });
+    for (const auto& block : meeting)
+      for (int f : block) {
+        add(f);
+        const Triangle& t = tris.back();
+        const int id = int(tris.size()) - 1;
+        for_cells(t.lo, t.hi, [&](std::uint64_t key) {
+          if (auto it = grid.find(key); it != grid.end()) it->second.push_back(id);
+        });
+      }
+  }
+  // The pairs of a cell, into `out`; false once `out` holds `limit`.
+  auto test_cell = [&](std::uint64_t key, const std::vector<int>& members, std::vector<std::pair<int, int>>& out) {
     for (std::size_t m = 0; m < members.size(); ++m)
       for (std::size_t n = m + 1; n < members.size(); ++n) {
         if (!flagged[std::size_t(members[m])] && !flagged[std::size_t(members[n])]) continue;
@@ -217,13 +269,25 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
         if (cell_key(index(lo[0], box.min[0]), index(lo[1], box.min[1]), index(lo[2], box.min[2])) != key) continue;
         if (pair_intersects(a, b, tol)) {
           const int f = face_of[std::size_t(members[m])], g = face_of[std::size_t(members[n])];
-          found.emplace_back(std::min(f, g), std::max(f, g));
-          if (found.size() >= limit) {
-            std::sort(found.begin(), found.end());
-            return found;
-          }
+          out.emplace_back(std::min(f, g), std::max(f, g));
+          if (out.size() >= limit) return false;
         }
       }
+    return true;
+  };
+  if (limit < std::numeric_limits<std::size_t>::max()) {  // stops at the limit: one cell after the other
+    for (const auto& [key, members] : grid)
+      if (!test_cell(key, members, found)) break;
+  } else {  // every pair: the cells in parallel (the set found is the same in any order)
+    std::vector<const std::pair<const std::uint64_t, std::vector<int>>*> cells;
+    cells.reserve(grid.size());
+    for (const auto& entry : grid) cells.push_back(&entry);
+    tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> local;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 256), [&](const auto& range) {
+      auto& out = local.local();
+      for (std::size_t c = range.begin(); c < range.end(); ++c) test_cell(cells[c]->first, cells[c]->second, out);
+    });
+    for (const auto& part : local) found.insert(found.end(), part.begin(), part.end());
   }
   std::sort(found.begin(), found.end());
   return found;
