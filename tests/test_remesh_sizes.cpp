@@ -337,38 +337,3 @@ TEST_CASE("a generated sphere is left in its order, remesh() renumbers a scatter
   CHECK_FALSE(arrays(plain) == ordered);
   CHECK(spatial_disorder(plain) > 0.05);
 }
-
-TEST_CASE("RemeshOptions::memory keeps the Z-order's disorder between calls: found once, the same arrays, found again when the mesh has grown") {
-  RemeshOptions options;
-  options.reference = ReferenceSurface::sphere(Vec3(0, 0, 0), 1.0);
-  auto scattered = [] {
-    auto mesh = scrambled_cap_mesh();
-    collect_garbage(mesh);
-    return mesh;
-  };
-  // Found at the first call that asks, and the same renumbering as without a memory.
-  auto with = scattered(), without = scattered();
-  options.memory = std::make_shared<RemeshMemory>();
-  remesh(with, options);
-  REQUIRE(options.memory->z_order_disorder >= 0);
-  CHECK(options.memory->z_order_disorder < 0.05);  // a cap in Z-order: ~1 %
-  CHECK(options.memory->vertices > 0);
-  auto no_memory = options;
-  no_memory.memory = nullptr;
-  remesh(without, no_memory);
-  CHECK(arrays(with) == arrays(without));
-  // Kept: a memory that says renumbering leaves as much disorder as there is keeps a scattered mesh
-  // as it is numbered...
-  auto kept = scattered();
-  const std::size_t n = kept.n_vertices();
-  *options.memory = RemeshMemory{1.0, n};
-  remesh(kept, options);
-  CHECK(spatial_disorder(kept) > 0.05);
-  CHECK(options.memory->z_order_disorder == 1.0);
-  // ...unless the vertex count has changed by more than a fifth since: then it is found again.
-  auto grown = scattered();
-  *options.memory = RemeshMemory{1.0, 2 * n};
-  remesh(grown, options);
-  CHECK(spatial_disorder(grown) < 0.05);
-  CHECK(options.memory->z_order_disorder < 0.05);
-}

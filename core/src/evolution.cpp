@@ -610,7 +610,7 @@ class Evolution {
     if (report.removed_detached > 0)
       spdlog::debug("n={}: {} part(s) of G detached from G^n given to the outside", n_ + 1, report.removed_detached);
     step.ms.discretize += clock.lap_ms();
-    RemeshOptions remeshing = remesh_options();
+    RemeshOptions remeshing = options_.remesh;
     if (changed) remeshing.changed = [&](VertexHandle v) { return (*changed)(v); };
     remesh(mesh_, remeshing);
     if (options_.canonical_order) canonicalize(mesh_);
@@ -684,7 +684,7 @@ class Evolution {
     candidate_ = true;  // until remeshed, the mesh is neither T^{n+1} nor its union
     discretize(mesh_, phi, options_.discretize);
     ms.discretize += clock.lap_ms();
-    remesh(mesh_, remesh_options());
+    remesh(mesh_, options_.remesh);
     if (options_.canonical_order) canonicalize(mesh_);
     ms.remesh += clock.lap_ms();
     measure_distance();
@@ -773,12 +773,6 @@ class Evolution {
   SurfaceMesh& mesh_;
   VelocityModel& model_;
   const EvolutionOptions& options_;
-  std::shared_ptr<RemeshMemory> remesh_memory_ = std::make_shared<RemeshMemory>();  // from step to step
-  RemeshOptions remesh_options() const {
-    RemeshOptions remeshing = options_.remesh;
-    if (!remeshing.memory) remeshing.memory = remesh_memory_;
-    return remeshing;
-  }
   const EvolutionHooks& hooks_;
   const ModelNeeds needs_;
   /// d^n and the advection in a band of the front (narrow_band); off for good once the model asks

@@ -234,16 +234,6 @@ bool Remesher::near_change(FaceHandle f) const {
   return false;
 }
 
-double Remesher::z_order_disorder() const {
-  RemeshMemory* memory = opt_.memory.get();
-  const std::size_t n = m_.n_vertices();
-  if (memory && memory->z_order_disorder >= 0 && 5 * n <= 6 * memory->vertices && 6 * n >= 5 * memory->vertices)
-    return memory->z_order_disorder;
-  const double disorder = spatial_disorder_after_reorder(m_);
-  if (memory) *memory = RemeshMemory{disorder, n};
-  return disorder;
-}
-
 void Remesher::final_sweep() {
   constexpr int kBlock = 4096;
   const int nf = int(m_.n_faces());
@@ -396,7 +386,7 @@ RemeshReport Remesher::run() {
   if (opt_.spatial_order && report_.splits + report_.collapses + report_.flips > 0 &&
       [&] {
         const double disorder = spatial_disorder(m_);
-        return disorder > kReorderAbove && z_order_disorder() < 0.5 * disorder;
+        return disorder > kReorderAbove && spatial_disorder_after_reorder(m_) < 0.5 * disorder;
       }())
     reorder_spatially(m_);
   else if (report_.collapses > 0)

@@ -211,8 +211,6 @@ class Remesher {
   std::size_t pass();
   bool near_change(FaceHandle f) const;
   void final_sweep();
-  /// spatial_disorder_after_reorder, from RemeshOptions::memory when it holds it.
-  double z_order_disorder() const;
 
   bool split(EdgeHandle e);
   bool collapse(EdgeHandle e);

@@ -62,19 +62,6 @@ struct RemeshOptions {
   /// (reorder_spatially) when it has become scattered in memory (spatial_disorder above 10 %);
   /// otherwise, and when false, only collect the garbage (collect_garbage).
   bool spatial_order = true;
-  /// Kept between the calls of a caller that remeshes one surface again and again (an evolution,
-  /// at every step): whether renumbering would halve the disorder needs the disorder the Z-order
-  /// itself leaves, a sort of every vertex (~10 ms at 117k vertices). On a surface much wider than
-  /// high that is ~11 %, above the 10 % that asks, and it was found again at every step. Null: found
-  /// at each call.
-  std::shared_ptr<struct RemeshMemory> memory;
-};
-
-/// What RemeshOptions::memory keeps: spatial_disorder_after_reorder and the vertex count it was
-/// found at (found again once the count has changed by a fifth); negative before the first.
-struct RemeshMemory {
-  double z_order_disorder = -1;
-  std::size_t vertices = 0;
 };
 
 /// Why the passes stopped.
