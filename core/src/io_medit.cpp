@@ -426,8 +426,9 @@ SurfaceMesh read_medit(const fs::path& file, const ReadOptions& options) {
 void write_medit(const SurfaceMesh& mesh, const fs::path& file, bool binary) {
   const MeditContent content = collect(mesh);
   if (binary) {
-    const auto [format, bytes] = binary_layout(content);
-    write_atomically(file, [&](std::ostream& out) { write_medit_binary(mesh, content, format, out); }, bytes);
+    const auto layout = binary_layout(content);  // not a structured binding: clang 14 cannot capture one
+    write_atomically(file, [&](std::ostream& out) { write_medit_binary(mesh, content, layout.first, out); },
+                     layout.second);
   } else {
     write_atomically(file, [&](std::ostream& out) { write_medit_text(mesh, content, out); });
   }
