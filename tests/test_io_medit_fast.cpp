@@ -316,7 +316,7 @@ TEST_CASE(".meshb: write -> read is bit-exact with refs, regions, interface, rid
   check_same_mesh(read_mesh(dir / "a.mesh"), back);
 }
 
-TEST_CASE("a write with its size announced: exactly the bytes written, over a bigger file, no blocks kept past the end") {
+TEST_CASE("a write with its size announced or not: exactly the bytes written, over a bigger file, no blocks kept past the end") {
   TempDir dir("io-fast-announced");
   const fs::path file = dir / "f.bin";
   const std::string big(3'000'000, 'a'), small(100'000, 'b');
@@ -337,6 +337,13 @@ TEST_CASE("a write with its size announced: exactly the bytes written, over a bi
   // Announced less than is written: the file grows past the announcement.
   write(big, small.size());
   CHECK(test::read_file(file) == big);
+  // Nothing announced over a bigger file: the size of the one replaced is allocated, and what was
+  // not written is given back the same way.
+  write(small, 0);
+  CHECK(test::read_file(file) == small);
+  REQUIRE(::stat(file.c_str(), &st) == 0);
+  CHECK(std::uint64_t(st.st_size) == small.size());
+  CHECK(std::uint64_t(st.st_blocks) * 512 < 2 * small.size());
   for (const auto& entry : fs::directory_iterator(dir.path())) CHECK_FALSE(is_atomic_temporary(entry.path().filename().string()));
 }
 

@@ -36,14 +36,24 @@ void write_atomically_at(const std::filesystem::path& target,
 
 void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write,
                       std::uint64_t expected_bytes) {
+  // Unannounced, a write over an existing file is taken to be the size of the file it replaces (an
+  // output rewritten at every step): that rename is the one that pays, a new name does not.
+  std::uint64_t allocate = expected_bytes;
+  if (allocate == 0) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(target, ec)) {
+      const std::uintmax_t size = std::filesystem::file_size(target, ec);
+      if (!ec) allocate = size;
+    }
+  }
   write_atomically_at(target, [&](const std::filesystem::path& temp) {
     auto mode = std::ios::binary | std::ios::trunc;
-    if (expected_bytes > 0) {
+    if (allocate > 0) {
       // Linux's fallocate, not posix_fallocate: where the filesystem cannot allocate, the latter
       // writes zeros instead. Any failure (no space, a file-size limit) shows again at the write.
       const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
       if (fd >= 0) {
-        if (::fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, off_t(expected_bytes)) == 0)
+        if (::fallocate(fd, FALLOC_FL_KEEP_SIZE, 0, off_t(allocate)) == 0)
           mode = std::ios::binary | std::ios::in | std::ios::out;  // keep the blocks: no truncation
         ::close(fd);
       }
@@ -59,7 +69,7 @@ void write_atomically(const std::filesystem::path& target, const std::function<v
       throw write_error(target, fmt::format("write failed ({})", error ? std::strerror(error) : "disk full?"));
     }
     // Blocks allocated past what was written are given back (a truncation to the same size does).
-    if (expected_bytes > 0 && std::uint64_t(out.tellp()) < expected_bytes) {
+    if (allocate > 0 && std::uint64_t(out.tellp()) < allocate) {
       std::error_code ec;
       std::filesystem::resize_file(temp, std::uint64_t(out.tellp()), ec);
     }

@@ -13,7 +13,8 @@ namespace bodyfit {
 /// `expected_bytes`, when known (a binary format's size follows from its counts), has the temporary's
 /// blocks allocated before the write: renaming a file over an existing one on ext4 otherwise makes
 /// the kernel allocate and start writing out the new file's blocks at the rename (~1 ms per MB).
-/// It is a hint: the file ends where the writer stopped, and a failed allocation changes nothing.
+/// Without it, a write over an existing file allocates the size of the file it replaces. It is a
+/// hint: the file ends where the writer stopped, and a failed allocation changes nothing.
 void write_atomically(const std::filesystem::path& target, const std::function<void(std::ostream&)>& write,
                       std::uint64_t expected_bytes = 0);
 /// The same for a writer that opens the file itself (a library that writes by name): `write` creates the temporary at the
