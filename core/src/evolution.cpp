@@ -179,6 +179,12 @@ class Evolution {
 
   EvolutionResult run() {
     try {
+      // CFL sub-steps know their band before V does (front_band_width): d^0 measured in it, as
+      // every later d^n is, and not on the whole surface (where the first V would be asked for).
+      if (banded_ && options_.max_cfl > 0) {
+        longest_edge_ = longest_edge(mesh_);
+        band_width_ = next_band_width(front_band_width() + 2 * longest_edge_);
+      }
       measure_distance();
       while (!should_stop()) advance();
       return finish();

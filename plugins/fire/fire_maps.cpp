@@ -4,6 +4,8 @@
 
 #include <bodyfit/geometry.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -25,7 +27,9 @@ bool plan_barycentric(const std::array<Vec3, 3>& p, double x, double y, std::arr
 }
 
 // Faces bucketed on a regular grid in plan view, to find the face above a point (x, y) of a
-// terrain (a height field: its projection on the plane is one-to-one).
+// terrain (a height field: its projection on the plane is one-to-one). The buckets are one array
+// (offsets per cell), each holding its faces in index order: the first face found is the same
+// however the buckets were filled.
 class PlanLocator {
  public:
   PlanLocator(const SurfaceMesh& mesh, double cell) : mesh_(mesh) {
@@ -35,22 +39,35 @@ class PlanLocator {
     cell_ = cell > 0 ? cell : 1.0;
     nx_ = std::max<long>(1, long(std::ceil((box.max[0] - x0_) / cell_)) + 1);
     ny_ = std::max<long>(1, long(std::ceil((box.max[1] - y0_) / cell_)) + 1);
-    buckets_.assign(std::size_t(nx_ * ny_), {});
-    for (auto f : mesh.faces()) {
+    // Each face's range of cells (i0, i1, j0, j1; empty for a deleted face), found in parallel.
+    const int nf = int(mesh.n_faces());
+    std::vector<std::array<long, 4>> ranges(std::size_t(nf), {0, -1, 0, -1});
+    tbb::parallel_for(0, nf, [&](int k) {
+      const FaceHandle f(k);
+      if (mesh.status(f).deleted()) return;
       auto p = face_points(mesh, f);
-      double xmin = std::min({p[0][0], p[1][0], p[2][0]}), xmax = std::max({p[0][0], p[1][0], p[2][0]});
-      double ymin = std::min({p[0][1], p[1][1], p[2][1]}), ymax = std::max({p[0][1], p[1][1], p[2][1]});
-      for (long j = index(ymin, y0_, ny_); j <= index(ymax, y0_, ny_); ++j)
-        for (long i = index(xmin, x0_, nx_); i <= index(xmax, x0_, nx_); ++i)
-          buckets_[std::size_t(j * nx_ + i)].push_back(f);
-    }
+      ranges[std::size_t(k)] = {index(std::min({p[0][0], p[1][0], p[2][0]}), x0_, nx_),
+                                index(std::max({p[0][0], p[1][0], p[2][0]}), x0_, nx_),
+                                index(std::min({p[0][1], p[1][1], p[2][1]}), y0_, ny_),
+                                index(std::max({p[0][1], p[1][1], p[2][1]}), y0_, ny_)};
+    });
+    auto for_cells = [&](const std::array<long, 4>& r, auto&& visit) {
+      for (long j = r[2]; j <= r[3]; ++j)
+        for (long i = r[0]; i <= r[1]; ++i) visit(std::size_t(j * nx_ + i));
+    };
+    start_.assign(std::size_t(nx_ * ny_) + 1, 0);
+    for (const auto& r : ranges) for_cells(r, [&](std::size_t c) { ++start_[c + 1]; });
+    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    faces_.resize(start_.back());
+    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+    for (int k = 0; k < nf; ++k) for_cells(ranges[std::size_t(k)], [&](std::size_t c) { faces_[next[c]++] = k; });
   }
 
   /// The face above (x, y) and the barycentric coordinates there; invalid face when outside.
   FaceHandle locate(double x, double y, std::array<double, 3>& bary) const {
-    long i = index(x, x0_, nx_), j = index(y, y0_, ny_);
-    for (FaceHandle f : buckets_[std::size_t(j * nx_ + i)])
-      if (plan_barycentric(face_points(mesh_, f), x, y, bary)) return f;
+    const std::size_t c = std::size_t(index(y, y0_, ny_) * nx_ + index(x, x0_, nx_));
+    for (std::size_t k = start_[c]; k < start_[c + 1]; ++k)
+      if (plan_barycentric(face_points(mesh_, FaceHandle(faces_[k])), x, y, bary)) return FaceHandle(faces_[k]);
     return FaceHandle();
   }
 
@@ -61,7 +78,8 @@ class PlanLocator {
   const SurfaceMesh& mesh_;
   double x0_ = 0, y0_ = 0, cell_ = 1;
   long nx_ = 1, ny_ = 1;
-  std::vector<std::vector<FaceHandle>> buckets_;
+  std::vector<std::size_t> start_;  ///< cell c's faces: faces_[start_[c] .. start_[c + 1])
+  std::vector<int> faces_;
 };
 
 double cell_center_x(const HeightGrid& g, std::size_t col) { return g.x_origin + (double(col) + 0.5) * g.cell_size; }
@@ -160,7 +178,8 @@ void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance,
   };
   if (!swept_ || changed.empty()) {
     PlanLocator locator(mesh, 2 * edge_length_stats(mesh).mean);
-    for (std::size_t row = 0; row < grid_.rows; ++row)
+    // Every cell on its own (it writes its own arrival, rate and recorded values): rows in parallel.
+    tbb::parallel_for(std::size_t(0), grid_.rows, [&](std::size_t row) {
       for (std::size_t col = 0; col < grid_.cols; ++col) {
         double& arrival = grid_.heights[row * grid_.cols + col];
         if (!std::isnan(arrival)) continue;
@@ -168,6 +187,7 @@ void ArrivalRaster::update(const SurfaceMesh& mesh, const ScalarField& distance,
         FaceHandle f = locator.locate(cell_center_x(grid_, col), cell_center_y(grid_, row), bary);
         if (f.is_valid()) reach(arrival, f, bary);
       }
+    });
     swept_ = true;
     return;
   }
