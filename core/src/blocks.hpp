@@ -29,6 +29,25 @@ std::vector<T> collect(int n, F&& f) {
   return all;
 }
 
+/// What f(i, out) appends to `out` for i in [0, n), in index order (into `all`, emptied first).
+template <class T, class F>
+void append_in_order(int n, std::vector<T>& all, F&& f) {
+  all.clear();
+  const int blocks = (n + kSweepBlock - 1) / kSweepBlock;
+  if (blocks <= 1) {  // one block: no copy
+    for (int i = 0; i < n; ++i) f(i, all);
+    return;
+  }
+  std::vector<std::vector<T>> parts(static_cast<std::size_t>(blocks));
+  tbb::parallel_for(0, blocks, [&](int b) {
+    for (int i = b * kSweepBlock; i < std::min(n, (b + 1) * kSweepBlock); ++i) f(i, parts[std::size_t(b)]);
+  });
+  std::size_t total = 0;
+  for (const auto& p : parts) total += p.size();
+  all.reserve(total);
+  for (const auto& p : parts) all.insert(all.end(), p.begin(), p.end());
+}
+
 /// `add(i, partial)` for i in [0, n), each block into its own partial (a copy of `zero`), the
 /// partials then folded in block order by `join(total, partial)`.
 template <class T, class Add, class Join>

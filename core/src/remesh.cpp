@@ -8,6 +8,7 @@
 #include <bodyfit/guards.hpp>
 
 #include <fmt/format.h>
+#include <tbb/parallel_sort.h>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
@@ -82,17 +83,69 @@ void Remesher::seed_work() {
 }
 
 // The edges around the work vertices, each once (an edge between two work vertices is taken from
-// the one with the smaller index).
-void Remesher::work_edges(std::vector<EdgeHandle>& edges) const {
-  edges.clear();
-  for (auto v : work_) {
-    if (m_.status(v).deleted()) continue;
+// the one with the smaller index), in the order of the work list: f(e, out) appends what it makes of
+// each, by blocks of the list in parallel, joined in order.
+template <class T, class F>
+void Remesher::gather_work_edges(std::vector<T>& out, F&& f) const {
+  append_in_order(int(work_.size()), out, [&](int i, std::vector<T>& part) {
+    const VertexHandle v = work_[std::size_t(i)];
+    if (m_.status(v).deleted()) return;
     for (auto h : m_.voh_range(v)) {
       auto w = m_.to_vertex_handle(h);
       if (m_.property(in_work_, w) && w.idx() < v.idx()) continue;
-      edges.push_back(m_.edge_handle(h));
+      f(m_.edge_handle(h), part);
+    }
+  });
+}
+
+void Remesher::work_edges(std::vector<EdgeHandle>& edges) const {
+  gather_work_edges(edges, [](EdgeHandle e, std::vector<EdgeHandle>& out) { out.push_back(e); });
+}
+
+void Remesher::rated_work_edges(std::vector<std::pair<double, EdgeHandle>>& rated) const {
+  gather_work_edges(rated, [&](EdgeHandle e, std::vector<std::pair<double, EdgeHandle>>& out) { out.emplace_back(ratio(e), e); });
+}
+
+namespace {
+
+// Longest first (shortest first for collapses); ties by index, so the order never depends on how the
+// list was gathered. The edges of a list are distinct: any sort gives the one order.
+void sort_longest_first(std::vector<std::pair<double, EdgeHandle>>& ranked) {
+  tbb::parallel_sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) {
+    return x.first != y.first ? x.first > y.first : x.second.idx() < y.second.idx();
+  });
+}
+
+void sort_shortest_first(std::vector<std::pair<double, EdgeHandle>>& ranked) {
+  tbb::parallel_sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) {
+    return x.first != y.first ? x.first < y.first : x.second.idx() < y.second.idx();
+  });
+}
+
+}  // namespace
+
+// Flip each edge in turn where it helps (flip()). Whether an edge's pair is poor enough to be worth
+// the check is found for all of them at once, in parallel; a pair that an earlier flip of the sweep
+// changed is looked at again, so the flips are those of the serial sweep.
+void Remesher::flip_in_order(const std::vector<EdgeHandle>& edges) {
+  const int n = int(edges.size());
+  worth_flipping_.resize(std::size_t(n));
+  for_each_index(n, [&](int i) { worth_flipping_[std::size_t(i)] = may_flip(edges[std::size_t(i)]); });
+  face_flipped_.resize(m_.n_faces(), 0);
+  flipped_faces_.clear();
+  for (int i = 0; i < n; ++i) {
+    const EdgeHandle e = edges[std::size_t(i)];
+    if (m_.status(e).deleted()) continue;
+    const FaceHandle f0 = m_.face_handle(m_.halfedge_handle(e, 0)), f1 = m_.face_handle(m_.halfedge_handle(e, 1));
+    auto changed = [&](FaceHandle f) { return f.is_valid() && face_flipped_[std::size_t(f.idx())]; };
+    if (!worth_flipping_[std::size_t(i)] && !changed(f0) && !changed(f1)) continue;
+    if (!flip(e)) continue;
+    for (auto f : {f0, f1}) {
+      face_flipped_[std::size_t(f.idx())] = 1;
+      flipped_faces_.push_back(f);
     }
   }
+  for (auto f : flipped_faces_) face_flipped_[std::size_t(f.idx())] = 0;
 }
 
 // First phase: split every edge above the split bound, longest first, in rounds until none is left.
@@ -112,19 +165,17 @@ void Remesher::split_long_edges() {
   const double faces_before = double(m_.n_faces());
   double area = -1, bound = 2 * faces_before;
   while (true) {
-    ranked_.clear();
-    for (auto e : edges_)
+    append_in_order(int(edges_.size()), ranked_, [&](int i, std::vector<std::pair<double, EdgeHandle>>& out) {
+      const EdgeHandle e = edges_[std::size_t(i)];
       if (!m_.status(e).deleted())
-        if (double r = ratio(e); r > kSplitRatio) ranked_.emplace_back(r, e);
+        if (double r = ratio(e); r > kSplitRatio) out.emplace_back(r, e);
+    });
     if (ranked_.empty()) break;
     if (area < 0 && double(m_.n_faces() + 2 * ranked_.size()) > bound) {
       area = total_area(m_);
       bound += 4 * faces_for_edge_length(area, hmin_);
     }
-    // Longest first; ties by index, so the order never depends on how the list was gathered.
-    std::sort(ranked_.begin(), ranked_.end(), [](const auto& x, const auto& y) {
-      return x.first != y.first ? x.first > y.first : x.second.idx() < y.second.idx();
-    });
+    sort_longest_first(ranked_);
     ++report_.split_rounds;
     // Room for the round's new elements at once (a split adds a vertex, three edges and two faces),
     // instead of the arrays doubling (and being copied) several times within it.
@@ -139,13 +190,32 @@ void Remesher::split_long_edges() {
           "others, needles; worst quality {:.3g}) — check the input",
           double(m_.n_faces() + 2 * k), hmin_, area, quality_stats(m_).min));
     m_.reserve(m_.n_vertices() + k, m_.n_edges() + 3 * k, m_.n_faces() + 2 * k);
+    // The midpoints' projections onto S, all at once in parallel: a split reads only its own edge's
+    // ends, which the round's other splits neither move nor change — unless the edge comes twice in
+    // the list and its first split halved it (then split() projects the new midpoint itself). A
+    // curve's projection, whose search tree is built on first use, stays in split().
+    projected_.resize(k);
+    for_each_index(int(k), [&](int i) {
+      const EdgeHandle e = ranked_[std::size_t(i)].second;
+      Projected& out = projected_[std::size_t(i)];
+      out.a = out.b = VertexHandle();
+      if (m_.property(ecurve_, e) != kNoCurve) return;
+      const auto h = m_.halfedge_handle(e, 0);
+      out.a = m_.from_vertex_handle(h);
+      out.b = m_.to_vertex_handle(h);
+      out.at = ref_->closest((m_.point(out.a) + m_.point(out.b)) * 0.5, m_.property(hint_, out.a));
+    });
     const std::size_t before = report_.splits;
     created.clear();
     edges_.clear();
-    for (auto& [r, e] : ranked_) {
+    for (std::size_t i = 0; i < k; ++i) {
+      const EdgeHandle e = ranked_[i].second;
       if (ratio(e) <= kSplitRatio) continue;
       const int n = int(m_.n_vertices());
-      if (split(e)) created.push_back(VertexHandle(n));
+      const auto h = m_.halfedge_handle(e, 0);
+      const Projected& mid = projected_[i];
+      const bool same = mid.a == m_.from_vertex_handle(h) && mid.b == m_.to_vertex_handle(h);
+      if (split(e, same ? &mid.at : nullptr)) created.push_back(VertexHandle(n));
       else edges_.push_back(e);
     }
     if (report_.splits == before) break;
@@ -154,7 +224,7 @@ void Remesher::split_long_edges() {
     // flipping them first saves splitting them (and collapsing the extra vertices afterwards).
     for (auto v : created)
       for (auto h : m_.voh_range(v)) edges_.push_back(m_.edge_handle(h));
-    for (auto e : edges_) flip(e);
+    flip_in_order(edges_);
   }
 }
 
@@ -166,32 +236,30 @@ std::size_t Remesher::pass() {
   const std::size_t ops = report_.splits + report_.collapses + report_.flips;
   std::size_t significant_moves = 0;
 
+  // The work edges with their ratios, gathered once for the split step's long ones and, when it
+  // splits none (a split re-queues its ring), the collapse step's short ones.
+  rated_work_edges(rated_);
   // Split the long edges, longest first.
-  work_edges(edges_);
   ranked_.clear();
-  for (auto e : edges_)
-    if (double r = ratio(e); r > kSplitRatio) ranked_.emplace_back(r, e);
-  std::sort(ranked_.begin(), ranked_.end(), [](const auto& x, const auto& y) {
-    return x.first != y.first ? x.first > y.first : x.second.idx() < y.second.idx();
-  });
+  for (const auto& [r, e] : rated_)
+    if (r > kSplitRatio) ranked_.emplace_back(r, e);
+  sort_longest_first(ranked_);
+  const std::size_t splits = report_.splits;
   for (auto& [r, e] : ranked_)
     if (!m_.status(e).deleted() && ratio(e) > kSplitRatio) split(e);
+  if (report_.splits != splits) rated_work_edges(rated_);
   // Collapse the short edges, shortest first.
-  work_edges(edges_);
   ranked_.clear();
-  for (auto e : edges_)
-    if (double r = ratio(e); r < kCollapseRatio) ranked_.emplace_back(r, e);
-  std::sort(ranked_.begin(), ranked_.end(), [](const auto& x, const auto& y) {
-    return x.first != y.first ? x.first < y.first : x.second.idx() < y.second.idx();
-  });
+  for (const auto& [r, e] : rated_)
+    if (r < kCollapseRatio) ranked_.emplace_back(r, e);
+  sort_shortest_first(ranked_);
   for (auto& [r, e] : ranked_) {
     if (m_.status(e).deleted() || ratio(e) >= kCollapseRatio) continue;
     collapse(e);
   }
   // Flip towards better triangles.
   work_edges(edges_);
-  for (auto e : edges_)
-    if (!m_.status(e).deleted()) flip(e);
+  flip_in_order(edges_);
   // Relocate: tangential smoothing, then projection onto S (or the curve). The loop may append to
   // work_ (rings of moved vertices), which this pass does not visit.
   const std::size_t to_smooth = work_.size();

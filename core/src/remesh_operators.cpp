@@ -3,14 +3,14 @@
 
 namespace bodyfit::remesh_detail {
 
-bool Remesher::split(EdgeHandle e) {
+bool Remesher::split(EdgeHandle e, const SurfacePoint* projected) {
   char curve = m_.property(ecurve_, e);
   if (curve == kRequiredCurve) return false;
   auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
   auto a = m_.from_vertex_handle(h0), b = m_.to_vertex_handle(h0);
   Vec3 p = (m_.point(a) + m_.point(b)) * 0.5;
   if (curve != kNoCurve) p = project_on_curve(p, curve);
-  SurfacePoint sp = ref_->closest(p, m_.property(hint_, a));
+  const SurfacePoint sp = projected ? *projected : ref_->closest(p, m_.property(hint_, a));
   if (curve != kBoundaryCurve || ref_->analytic()) p = sp.point;
 
   // The two (or one) opposite vertices and their face regions; the new point must not fold them.
@@ -310,6 +310,25 @@ bool Remesher::flip(EdgeHandle e) {
   return true;
 }
 
+namespace {
+
+// The worse of the two triangles on an edge a → b, c and d across it: the pair a flip replaces.
+double pair_quality(const Vec3& pa, const Vec3& pb, const Vec3& pc, const Vec3& pd) {
+  return std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+}
+
+}  // namespace
+
+// Whether flip_check (Rule::Pass) looks past its first test: a free edge between two faces whose
+// pair has a triangle below kFlipBelow.
+bool Remesher::may_flip(EdgeHandle e) const {
+  if (m_.status(e).deleted() || m_.property(ecurve_, e) != kNoCurve || m_.is_boundary(e)) return false;
+  auto h0 = m_.halfedge_handle(e, 0), h1 = m_.halfedge_handle(e, 1);
+  return pair_quality(m_.point(m_.from_vertex_handle(h0)), m_.point(m_.to_vertex_handle(h0)),
+                      m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(h0))),
+                      m_.point(m_.to_vertex_handle(m_.next_halfedge_handle(h1)))) < kFlipBelow;
+}
+
 // Whether flipping e keeps the pair flat on S and is worth it by `rule`; `change` receives the
 // qualities of the two pairs.
 bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
@@ -319,7 +338,7 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
   auto c = m_.to_vertex_handle(m_.next_halfedge_handle(h0));
   auto d = m_.to_vertex_handle(m_.next_halfedge_handle(h1));
   const Vec3 &pa = m_.point(a), &pb = m_.point(b), &pc = m_.point(c), &pd = m_.point(d);
-  change.old_min = std::min(triangle(pa, pb, pc).quality, triangle(pb, pa, pd).quality);
+  change.old_min = pair_quality(pa, pb, pc, pd);
   // Only pairs with a poor triangle are worth changing in the passes: a good mesh stays as it is
   // (decided before the new pair is computed: most pairs a pass looks at are good).
   if (rule == Rule::Pass && change.old_min >= kFlipBelow) return false;

@@ -206,18 +206,24 @@ class Remesher {
     m_.property(depth_, v) = 0;
     mark(v);
   }
+  template <class T, class F>
+  void gather_work_edges(std::vector<T>& out, F&& f) const;
   void work_edges(std::vector<EdgeHandle>& edges) const;
+  void rated_work_edges(std::vector<std::pair<double, EdgeHandle>>& rated) const;
+  void flip_in_order(const std::vector<EdgeHandle>& edges);
   void split_long_edges();
   std::size_t pass();
   bool near_change(FaceHandle f) const;
   void final_sweep();
 
-  bool split(EdgeHandle e);
+  // `projected`: the edge's midpoint already projected onto S (ref_->closest from its first end's hint).
+  bool split(EdgeHandle e, const SurfacePoint* projected = nullptr);
   bool collapse(EdgeHandle e);
   bool collapse_check(HalfedgeHandle h, Change& change, Rule rule) const;
   bool curve_collapse_within_hausd(HalfedgeHandle h) const;
   void collapse_halfedge(HalfedgeHandle h);
   bool flip(EdgeHandle e);
+  bool may_flip(EdgeHandle e) const;
   bool flip_check(EdgeHandle e, Change& change, Rule rule) const;
   void flip_edge(EdgeHandle e);
   bool feature_flip_check(HalfedgeHandle h, Change& change) const;
@@ -286,7 +292,14 @@ class Remesher {
   std::vector<VertexHandle> work_, next_;
   // Scratch buffers reused by every pass and check (no allocation per operation).
   std::vector<EdgeHandle> edges_;
-  std::vector<std::pair<double, EdgeHandle>> ranked_;
+  std::vector<std::pair<double, EdgeHandle>> ranked_, rated_;
+  struct Projected {
+    VertexHandle a, b;  // the edge's ends (invalid: not projected)
+    SurfacePoint at;    // the projection of their midpoint
+  };
+  std::vector<Projected> projected_;
+  std::vector<char> worth_flipping_, face_flipped_;
+  std::vector<FaceHandle> flipped_faces_;
   mutable std::vector<FaceHandle> star_;
   mutable std::vector<std::array<VertexHandle, 3>> after_;
   mutable std::vector<Vec3> normals_;
