@@ -269,6 +269,12 @@ SurfacePoint ReferenceSurface::closest(const Vec3& p, int hint) const {
   return out;
 }
 
+double ReferenceSurface::distance_to_triangle(const Vec3& p, int i) const {
+  if (is_sphere_ || i < 0 || i >= int(tri_.size())) return std::numeric_limits<double>::infinity();
+  const auto& t = tri_[std::size_t(i)];
+  return (closest_point_on_triangle(p, points_[t[0]], points_[t[1]], points_[t[2]]) - p).norm();
+}
+
 Vec3 ReferenceSurface::smooth_normal(const SurfacePoint& q) const {
   if (q.face < 0) return q.normal;
   const auto& t = tri_[std::size_t(q.face)];

@@ -172,9 +172,15 @@ double Remesher::chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) cons
 }
 
 // Whether the chord (a, b) replacing the chord (a_old, b_old) stays within hausd of S, or sags no
-// more than the one it replaces.
+// more than the one it replaces. `faces`: reference triangles near the chord's ends; its middle
+// within hausd of one of them proves the first without searching S (the search would find no
+// farther point: the margin is far above its rounding).
 bool Remesher::chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old,
-                                  const Vec3& b_old) const {
+                                  const Vec3& b_old, std::initializer_list<int> faces) const {
+  if (!check_distance_) return true;
+  const Vec3 mid = (a + b) * 0.5;
+  for (int face : faces)
+    if (ref_->distance_to_triangle(mid, face) <= hausd_ * (1 - 1e-9)) return true;
   const double sag = chord_sag(near, a, b);
   return sag <= hausd_ || sag <= chord_sag(near, a_old, b_old);
 }
@@ -251,7 +257,9 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change, Rule rule) const
   if (folds(after, star)) return false;
   if (!near_surface(m_.point(v0), after)) return false;
   for (auto w : m_.vv_range(v0))
-    if (w != v1 && !chord_within_hausd(v1, p1, m_.point(w), m_.point(v0), m_.point(w))) return false;
+    if (w != v1 && !chord_within_hausd(v1, p1, m_.point(w), m_.point(v0), m_.point(w),
+                                       {m_.property(hint_, v1), m_.property(hint_, w)}))
+      return false;
   change.old_min = old_min;
   change.new_min = new_min;
   return true;
@@ -365,7 +373,7 @@ bool Remesher::flip_check(EdgeHandle e, Change& change, Rule rule) const {
     const std::array<std::array<VertexHandle, 3>, 2> before{{{a, b, c}, {b, a, d}}};
     const double now = distance_to(q, after);
     if (now > hausd_ && now > distance_to(q, before)) return false;
-    if (!chord_within_hausd(c, pc, pd, pa, pb)) return false;
+    if (!chord_within_hausd(c, pc, pd, pa, pb, {m_.property(hint_, c), m_.property(hint_, d)})) return false;
   }
   return true;
 }
@@ -405,7 +413,8 @@ double Remesher::relocate(VertexHandle v) {
       if (!m_.is_boundary(h)) star.push_back({v, m_.to_vertex_handle(h), m_.to_vertex_handle(m_.next_halfedge_handle(h))});
     if (!near_surface(p, star, v, q)) return 0;
     for (auto w : m_.vv_range(v))
-      if (!chord_within_hausd(v, q, m_.point(w), p, m_.point(w))) return 0;
+      if (!chord_within_hausd(v, q, m_.point(w), p, m_.point(w), {sp.face, m_.property(hint_, w), m_.property(hint_, v)}))
+        return 0;
   }
   // Curve vertices move only to repair a poor triangle: a point between the reference curve's
   // vertices lies on a chord, off the true curve by up to h²κ/8.

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <queue>
@@ -241,7 +242,8 @@ class Remesher {
   double distance_to(const Vec3& p, std::span<const std::array<VertexHandle, 3>> triangles,
                      VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
   double chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) const;
-  bool chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old, const Vec3& b_old) const;
+  bool chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old, const Vec3& b_old,
+                          std::initializer_list<int> faces) const;
   std::size_t repair_slivers();
   void repair_self_intersections();
   std::vector<std::pair<double, FaceHandle>> slivers_;  // faces below kRepairBelow (final_sweep)

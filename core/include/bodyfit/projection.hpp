@@ -32,6 +32,9 @@ class ReferenceSurface {
 
   /// Closest point of S to p. `hint` (a reference triangle near p, or -1) speeds up the search.
   SurfacePoint closest(const Vec3& p, int hint = -1) const;
+  /// The distance from p to reference triangle `i` (infinite for an analytic S or no such
+  /// triangle): an upper bound of p's distance to S, the one closest(p, i) starts its search from.
+  double distance_to_triangle(const Vec3& p, int i) const;
   /// S's smooth unit normal at its closest point to p: S's vertex normals (area-weighted, as
   /// vertex_normal()) interpolated barycentrically there. A continuous field and one function of
   /// position, whatever mesh samples it; at a vertex of S it is S's vertex normal (a sphere: exact).
