@@ -59,12 +59,17 @@ bool gather_as(OpenMesh::BaseProperty& property, const std::vector<int>& order, 
 }
 
 // Put element order[i] (times stride: halfedges follow their edge) at position i, for a property of
-// any type: the common types by a parallel gather, any other by swaps along the permutation's
-// cycles (the deleted elements go after the live ones and are cut off by the resize that follows).
+// any type: the common types by a parallel gather (OpenMesh's per-element traits data, empty
+// structs here, among them), any other by swaps along the permutation's cycles (the deleted
+// elements go after the live ones and are cut off by the resize that follows).
 void permute(OpenMesh::BaseProperty& property, const std::vector<int>& order, const std::vector<int>& map, int stride) {
   if (gather_as<Vec3>(property, order, stride) || gather_as<double>(property, order, stride) ||
       gather_as<int>(property, order, stride) || gather_as<char>(property, order, stride) ||
-      gather_as<OpenMesh::Attributes::StatusInfo>(property, order, stride))
+      gather_as<OpenMesh::Attributes::StatusInfo>(property, order, stride) ||
+      gather_as<SurfaceMesh::VertexData>(property, order, stride) ||
+      gather_as<SurfaceMesh::EdgeData>(property, order, stride) ||
+      gather_as<SurfaceMesh::HalfedgeData>(property, order, stride) ||
+      gather_as<SurfaceMesh::FaceData>(property, order, stride))
     return;
   const int n = int(map.size());
   std::vector<int> full(order);
