@@ -445,10 +445,17 @@ std::optional<std::pair<VertexHandle, VertexHandle>> Remesher::curve_neighbours(
 // Where v goes for a target point: its projection onto S (a boundary vertex of a non-analytic
 // surface stays on its polyline). False for a move too small to matter.
 bool Remesher::place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const {
+  const double small = 1e-3 * m_.property(size_, v);
+  const Vec3& p = m_.point(v);
+  const bool on_polyline = m_.property(kind_, v) == kCurveVertex && m_.property(vcurve_, v) == kBoundaryCurve && !ref_->analytic();
+  // A move too small is often known before the search (a third of the relocations of a remesh to
+  // a size): S's closest point to the target is no farther from it than the triangle v lies on,
+  // so it is within |target − p| plus that distance of p. The slack is far above the rounding.
+  const double reach = (target - p).norm() + (on_polyline ? 0.0 : ref_->distance_to_triangle(target, m_.property(hint_, v)));
+  if (reach + 1e-11 * (reach + std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])})) < small) return false;
   sp = ref_->closest(target, m_.property(hint_, v));
-  bool on_polyline = m_.property(kind_, v) == kCurveVertex && m_.property(vcurve_, v) == kBoundaryCurve && !ref_->analytic();
   q = on_polyline ? target : sp.point;
-  return (q - m_.point(v)).norm() >= 1e-3 * m_.property(size_, v);
+  return (q - p).norm() >= small;
 }
 
 // Whether moving v to q folds none of its triangles (normal: S's normal at q); `change` receives
