@@ -72,6 +72,16 @@ void check_nearest(const SurfaceMesh& mesh, int samples) {
       CHECK(std::abs(found - std::sqrt(exact)) <= 1e-13 * size);
       auto [qa, qb, qc] = face_points(mesh, FaceHandle(q.face));
       CHECK((closest_point_on_triangle(q.point, qa, qb, qc) - q.point).norm() <= 1e-12 * size);
+      // The distance to one triangle, from above: what the remesher refuses moves and accepts
+      // chords by without a search.
+      const double to_hint = surface.distance_to_triangle(p, hint);
+      if (hint < 0) {
+        CHECK(std::isinf(to_hint));
+      } else {
+        auto [ha, hb, hc] = face_points(mesh, FaceHandle(hint));
+        CHECK(std::abs(to_hint - (closest_point_on_triangle(p, ha, hb, hc) - p).norm()) <= 1e-13 * size);
+        CHECK(found <= to_hint * (1 + 1e-12) + 1e-15 * size);
+      }
       ++checked;
     }
   }
@@ -82,6 +92,9 @@ void check_nearest(const SurfaceMesh& mesh, int samples) {
 
 TEST_CASE("ReferenceSurface::closest is the nearest of all the triangles: a sphere, a creased part, meshes with holes") {
   SUBCASE("a geodesic sphere") { check_nearest(make_sphere({.faces = 20000}), 600); }
+  SUBCASE("the exact sphere has no triangles to bound by") {
+    CHECK(std::isinf(ReferenceSurface::sphere(Vec3(0, 0, 0), 1)->distance_to_triangle(Vec3(0, 0, 2), 0)));
+  }
   SUBCASE("public meshes: creases, boundaries, handles, very uneven triangles") {
     for (const char* name : {"fandisk", "anchor", "knot1", "elephant-with-holes"}) {
       const fs::path file = fs::path(BODYFIT_SOURCE_DIR) / "meshes/public" / (std::string(name) + ".off");

@@ -7,6 +7,7 @@
 
 #include <bodyfit/generators.hpp>
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/io.hpp>
 #include <bodyfit/levelset_mesher.hpp>
 #include <bodyfit/projection.hpp>
 #include <bodyfit/remesh.hpp>
@@ -17,12 +18,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <numeric>
 #include <random>
 #include <tuple>
 #include <vector>
 
 using namespace bodyfit;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -195,6 +198,28 @@ TEST_CASE("refining a sphere ×3 and ×10 in one call: no edge above the split b
     // Edges between 0.71 and 1.41 hmax (the mean near hmax): about factor² as many faces.
     CHECK(double(mesh.n_faces()) > 0.5 * factor * factor * 500);
     CHECK(double(mesh.n_faces()) < 3.0 * factor * factor * 500);
+  }
+}
+
+TEST_CASE("remeshing to a size gives the same arrays with one thread and with two") {
+  // Refined ×3, the work lists and a split round's edges span many blocks of the parallel gathers
+  // (work edges, midpoint projections, flip screening); fandisk's creases turn the distance checks
+  // on (a chord's sag proven from the triangles at its ends, or searched).
+  const auto fandisk = read_mesh(fs::path(BODYFIT_SOURCE_DIR) / "meshes/public/fandisk.off");
+  for (const auto& [name, input] : {std::pair{"sphere", make_sphere({.faces = 8000})}, std::pair{"fandisk", fandisk}}) {
+    CAPTURE(name);
+    Arrays expected;
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+      SurfaceMesh mesh = input;
+      RemeshOptions options;
+      options.hmax = edge_length_stats(mesh).mean / 3;
+      const auto report = remesh(mesh, options);
+      CHECK(report.splits > 8192);
+      if (threads == 1) expected = arrays(mesh);
+      else CHECK(arrays(mesh) == expected);
+    }
   }
 }
 
