@@ -298,6 +298,13 @@ RunMap load_run_map(const std::filesystem::path& run_dir) {
   RunMap run;
   run.mesh = read_mesh(mesh_file);
   run.mesh.garbage_collection();
+  run.layers = load_map_layers(run_dir);
+  return run;
+}
+
+MapLayers load_map_layers(const std::filesystem::path& run_dir) {
+  namespace fs = std::filesystem;
+  RunMap run;
   for (const char* name : {"arrival_time.tif", "arrival_time.asc"})  // the fire model's format, GeoTIFF by default
     if (const fs::path arrival = run_dir / name; fs::exists(arrival)) {
       run.layers.arrival = read_raster_values(arrival);
@@ -320,7 +327,7 @@ RunMap load_run_map(const std::filesystem::path& run_dir) {
       run.layers.clock_start = parse_iso8601(*start);
     }
   }
-  return run;
+  return run.layers;
 }
 
 }  // namespace bodyfit

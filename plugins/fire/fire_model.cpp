@@ -14,6 +14,7 @@
 #include <bodyfit/geometry.hpp>
 #include <bodyfit/app/map.hpp>
 #include <bodyfit/parameters.hpp>
+#include <bodyfit/remesh.hpp>
 #include <bodyfit/app/plan_geometry.hpp>
 #include <bodyfit/app/raster_io.hpp>
 #include <bodyfit/app/vector_io.hpp>
@@ -540,13 +541,21 @@ class FireModel final : public VelocityModel {
     }
     if (output_dir.empty()) return;
     write_perimeters(output_dir);
-    // The run's map (docs/reference/fire_model.md, "Maps"), drawn from the files just written. A map that cannot be
-    // drawn (no Cairo) costs the run nothing: its results are all written.
+    // The run's map (docs/reference/fire_model.md, "Maps"): the final state's mesh, which final.mesh was just written
+    // from (reading it back would give the same mesh), and the layers from the files just written. A map that
+    // cannot be drawn (no Cairo) costs the run nothing: its results are all written.
     // Only after `bodyfit run`, which writes final.mesh first; not when a program calls evolve().
     if (!arrival_.initialised() || !config::have_cairo || !std::filesystem::exists(output_dir / "final.mesh")) return;
     try {
-      RunMap run = load_run_map(output_dir);
-      draw_fire_map(output_dir / "fire_map.png", run.mesh, run.layers, {.title = "Fire map: burnt area and arrival time"});
+      const MapLayers layers = load_map_layers(output_dir);
+      const MapOptions options{.title = "Fire map: burnt area and arrival time"};
+      if (!has_deleted_elements(final_state.mesh())) {
+        draw_fire_map(output_dir / "fire_map.png", final_state.mesh(), layers, options);
+      } else {  // as final.mesh holds it: compacted
+        SurfaceMesh mesh = final_state.mesh();
+        collect_garbage(mesh);
+        draw_fire_map(output_dir / "fire_map.png", mesh, layers, options);
+      }
     } catch (const std::exception& e) {
       spdlog::warn("fire_map.png not drawn: {}", e.what());
     }

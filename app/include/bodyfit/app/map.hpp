@@ -140,6 +140,9 @@ struct RunMap {
   MapLayers layers;
 };
 RunMap load_run_map(const std::filesystem::path& run_dir);
+/// The layers alone (all of load_run_map but final.mesh): for a run that draws its own map from
+/// the mesh it has just written.
+MapLayers load_map_layers(const std::filesystem::path& run_dir);
 
 /// The name of a coordinate system given as WKT (its first quoted string: PROJCS["name", ...]).
 std::string crs_name_of_wkt(const std::string& wkt);
