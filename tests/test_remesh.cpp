@@ -944,15 +944,22 @@ TEST_CASE("self-intersections near some faces: exactly the pairs of the whole se
   const auto all = self_intersections(two);
   REQUIRE(all.size() > 100);
   CHECK(std::is_sorted(all.begin(), all.end()));
-  for (int stride : {1, 3, 7}) {
-    CAPTURE(stride);
-    std::vector<int> faces;
-    for (int f = 0; f < int(two.n_faces()); f += stride) faces.push_back(f);
-    std::vector<std::pair<int, int>> expected;
-    for (const auto& [f, g] : all)
-      if (f % stride == 0 || g % stride == 0) expected.push_back({f, g});
-    CHECK(self_intersections_near(two, faces) == expected);
-  }
+  // The same with a lone triangle far away: a box of too many cells for the table of occupied
+  // cells, which the search then looks up in its grid.
+  SurfaceMesh far = two;
+  far.add_face(far.add_vertex(Vec3(1e4, 1e4, 1e4)), far.add_vertex(Vec3(1e4 + 0.1, 1e4, 1e4)),
+               far.add_vertex(Vec3(1e4, 1e4 + 0.1, 1e4)));
+  CHECK(self_intersections(far) == all);
+  for (const SurfaceMesh* mesh : {&two, &far})
+    for (int stride : {1, 3, 7}) {
+      CAPTURE(stride);
+      std::vector<int> faces;
+      for (int f = 0; f < int(mesh->n_faces()); f += stride) faces.push_back(f);
+      std::vector<std::pair<int, int>> expected;
+      for (const auto& [f, g] : all)
+        if (f % stride == 0 || g % stride == 0) expected.push_back({f, g});
+      CHECK(self_intersections_near(*mesh, faces) == expected);
+    }
   // A patch of one sphere only (its first 200 faces): no pair without one of them.
   std::vector<int> patch(200);
   std::iota(patch.begin(), patch.end(), 0);

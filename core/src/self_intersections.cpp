@@ -201,10 +201,13 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
   if (live < 2) return found;
   const double cell = std::max(2 * edge_sum / (3.0 * double(live)), diagonal * 1e-6);
   auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
-  auto for_cells = [&](const Vec3& lo, const Vec3& hi, auto&& visit) {
+  auto for_cell_indices = [&](const Vec3& lo, const Vec3& hi, auto&& visit) {
     for (auto i = index(lo[0], box.min[0]); i <= index(hi[0], box.min[0]); ++i)
       for (auto j = index(lo[1], box.min[1]); j <= index(hi[1], box.min[1]); ++j)
-        for (auto k = index(lo[2], box.min[2]); k <= index(hi[2], box.min[2]); ++k) visit(cell_key(i, j, k));
+        for (auto k = index(lo[2], box.min[2]); k <= index(hi[2], box.min[2]); ++k) visit(i, j, k);
+  };
+  auto for_cells = [&](const Vec3& lo, const Vec3& hi, auto&& visit) {
+    for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) { visit(cell_key(i, j, k)); });
   };
 
   std::vector<Triangle> tris;
@@ -234,15 +237,37 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     for_cells(t.lo, t.hi, [&](std::uint64_t key) { grid[key].push_back(id); });
   }
   if (near) {
+    // The cells the flagged triangles occupy, as a table over the box's cells (one more on each
+    // side for the tolerance) when it is small: the sweep below looks them up without hashing.
+    const std::int64_t nx = index(box.max[0], box.min[0]) + 3, ny = index(box.max[1], box.min[1]) + 3,
+                       nz = index(box.max[2], box.min[2]) + 3;
+    std::vector<char> occupied;
+    if (nx * ny * nz <= (std::int64_t(1) << 26)) {
+      occupied.assign(std::size_t(nx * ny * nz), 0);
+      for (const Triangle& t : tris)
+        for_cell_indices(t.lo, t.hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+          occupied[std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)))] = 1;
+        });
+    }
+    auto meets_flagged = [&](const Vec3& lo, const Vec3& hi) {
+      bool meets = false;
+      if (occupied.empty()) {
+        for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || grid.count(key) > 0; });
+      } else {
+        for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+          meets = meets || (i >= -1 && i < nx - 1 && j >= -1 && j < ny - 1 && k >= -1 && k < nz - 1 &&
+                            occupied[std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)))]);
+        });
+      }
+      return meets;
+    };
     std::vector<std::vector<int>> meeting(static_cast<std::size_t>(blocks));
     tbb::parallel_for(0, blocks, [&](int b) {
       for (int f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
         if (surface.status(FaceHandle(f)).deleted() || is_flagged(f)) continue;
         Vec3 lo, hi;
         bounds(corners(f), lo, hi);
-        bool meets = false;
-        for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || grid.count(key) > 0; });
-        if (meets) meeting[std::size_t(b)].push_back(f);
+        if (meets_flagged(lo, hi)) meeting[std::size_t(b)].push_back(f);
       }
     });
     for (const auto& block : meeting)
