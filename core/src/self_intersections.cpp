@@ -241,22 +241,29 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     // side for the tolerance) when it is small: the sweep below looks them up without hashing.
     const std::int64_t nx = index(box.max[0], box.min[0]) + 3, ny = index(box.max[1], box.min[1]) + 3,
                        nz = index(box.max[2], box.min[2]) + 3;
+    auto in_table = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+      return i >= -1 && i < nx - 1 && j >= -1 && j < ny - 1 && k >= -1 && k < nz - 1;
+    };
+    auto cell_of = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+      return std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)));
+    };
     std::vector<char> occupied;
-    if (nx * ny * nz <= (std::int64_t(1) << 26)) {
+    bool whole_table = nx > 0 && ny > 0 && nz > 0 && nx * ny * nz <= (std::int64_t(1) << 26);
+    if (whole_table) {
       occupied.assign(std::size_t(nx * ny * nz), 0);
       for (const Triangle& t : tris)
         for_cell_indices(t.lo, t.hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-          occupied[std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)))] = 1;
+          if (in_table(i, j, k)) occupied[cell_of(i, j, k)] = 1;
+          else whole_table = false;  // not expected (every triangle is in the box): the grid then
         });
     }
     auto meets_flagged = [&](const Vec3& lo, const Vec3& hi) {
       bool meets = false;
-      if (occupied.empty()) {
+      if (!whole_table) {
         for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || grid.count(key) > 0; });
       } else {
         for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-          meets = meets || (i >= -1 && i < nx - 1 && j >= -1 && j < ny - 1 && k >= -1 && k < nz - 1 &&
-                            occupied[std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)))]);
+          meets = meets || (in_table(i, j, k) && occupied[cell_of(i, j, k)]);
         });
       }
       return meets;
