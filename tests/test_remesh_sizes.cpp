@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <numeric>
 #include <random>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -206,7 +207,9 @@ TEST_CASE("remeshing to a size gives the same arrays with one thread and with tw
   // (work edges, midpoint projections, flip screening); fandisk's creases turn the distance checks
   // on (a chord's sag proven from the triangles at its ends, or searched).
   const auto fandisk = read_mesh(fs::path(BODYFIT_SOURCE_DIR) / "meshes/public/fandisk.off");
-  for (const auto& [name, input] : {std::pair{"sphere", make_sphere({.faces = 8000})}, std::pair{"fandisk", fandisk}}) {
+  for (const auto& named : {std::pair{"sphere", make_sphere({.faces = 8000})}, std::pair{"fandisk", fandisk}}) {
+    const std::string name = named.first;
+    const SurfaceMesh& input = named.second;
     CAPTURE(name);
     Arrays expected;
     for (int threads : {1, 2}) {
