@@ -304,11 +304,11 @@ RunMap load_run_map(const std::filesystem::path& run_dir) {
 
 MapLayers load_map_layers(const std::filesystem::path& run_dir) {
   namespace fs = std::filesystem;
-  RunMap run;
+  MapLayers layers;
   for (const char* name : {"arrival_time.tif", "arrival_time.asc"})  // the fire model's format, GeoTIFF by default
     if (const fs::path arrival = run_dir / name; fs::exists(arrival)) {
-      run.layers.arrival = read_raster_values(arrival);
-      run.layers.crs_name = crs_name_of_wkt(run.layers.arrival.crs);
+      layers.arrival = read_raster_values(arrival);
+      layers.crs_name = crs_name_of_wkt(layers.arrival.crs);
       break;
     }
   if (const fs::path case_file = run_dir / "case.toml"; fs::exists(case_file)) {
@@ -317,17 +317,17 @@ MapLayers load_map_layers(const std::filesystem::path& run_dir) {
       if (const toml::array* centres = table["region"]["centers"].as_array())
         for (const toml::node& centre : *centres)
           if (const toml::array* xy = centre.as_array(); xy && xy->size() >= 2)
-            run.layers.ignitions.emplace_back((*xy)[0].value_or(0.0), (*xy)[1].value_or(0.0), 0.0);
-    } else if (run.layers.arrival.cols > 0) {
+            layers.ignitions.emplace_back((*xy)[0].value_or(0.0), (*xy)[1].value_or(0.0), 0.0);
+    } else if (layers.arrival.cols > 0) {
       // Ignitions from a layer (points, lines, polygons, some later than others), or any shape:
       // where the arrival time starts.
-      run.layers.ignitions = ignitions_from_arrival(run.layers.arrival);
+      layers.ignitions = ignitions_from_arrival(layers.arrival);
     }
     if (const auto start = table["time"]["start"].value<std::string>()) {
-      run.layers.clock_start = parse_iso8601(*start);
+      layers.clock_start = parse_iso8601(*start);
     }
   }
-  return run.layers;
+  return layers;
 }
 
 }  // namespace bodyfit
