@@ -13,7 +13,7 @@ struct Command {
   CLI::App* app = nullptr;
   std::function<int()> run;
   /// A one-shot stage whose time goes mostly into first touching its arrays: run on huge pages
-  /// (huge_page_heap.hpp).
+  /// (bodyfit/app/huge_page_heap.hpp).
   bool on_huge_pages = false;
 };
 /// Adds the subcommand to `app` and returns it with its runner.

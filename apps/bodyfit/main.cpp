@@ -1,10 +1,10 @@
 // bodyfit: body-fitted tracking of a region moving inside a fixed surface.
 #include "commands.hpp"
-#include "huge_page_heap.hpp"
 #include "validators.hpp"
 #include "mmg_spellings.hpp"
 #include "self_documentation.hpp"
 
+#include <bodyfit/app/huge_page_heap.hpp>
 #include <bodyfit/app/shared_data.hpp>
 #include <bodyfit/config.hpp>
 #include <bodyfit/error.hpp>
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
   }
 
   for (const auto& command : added)
-    if (command.app->parsed() && command.on_huge_pages) cli::restart_on_huge_pages(argv);
+    if (command.app->parsed() && command.on_huge_pages) restart_on_huge_pages(argv);
 
   set_max_faces(max_faces);
   // oneTBB's limit for the whole process, the plugins' parallel loops included.
@@ -139,7 +139,7 @@ int main(int argc, char** argv) {
   try {
     for (auto& command : added) {
       if (!command.app->parsed()) continue;
-      if (command.on_huge_pages && cli::heap_on_huge_pages())
+      if (command.on_huge_pages && heap_on_huge_pages())
         spdlog::debug("heap on transparent huge pages (GLIBC_TUNABLES glibc.malloc.hugetlb=1)");
       return command.run();
     }

@@ -1,5 +1,5 @@
 #pragma once
-// One-shot commands on transparent huge pages.
+// One-shot processes on transparent huge pages.
 //
 // A process's fresh memory costs a page fault per 4 KiB page at its first write. On the virtual
 // machines bodyfit is measured on a fault costs ~14 µs, so a stage command (read a mesh, one stage,
@@ -9,7 +9,7 @@
 // iterations reuse the heap they grew, and on huge pages they were not faster
 // (docs/validation/performance.md).
 
-namespace bodyfit::cli {
+namespace bodyfit {
 
 /// Replaces this process by the same program with the same arguments and glibc's heap on huge
 /// pages, unless GLIBC_TUNABLES already names glibc.malloc.hugetlb (the restarted process, or a
@@ -20,4 +20,4 @@ void restart_on_huge_pages(char** argv);
 /// Whether this process started with glibc.malloc.hugetlb=1.
 bool heap_on_huge_pages();
 
-}  // namespace bodyfit::cli
+}  // namespace bodyfit

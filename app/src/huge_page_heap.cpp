@@ -1,4 +1,4 @@
-#include "huge_page_heap.hpp"
+#include <bodyfit/app/huge_page_heap.hpp>
 
 #include <cstdlib>
 #include <fstream>
@@ -6,7 +6,7 @@
 
 #include <unistd.h>
 
-namespace bodyfit::cli {
+namespace bodyfit {
 
 void restart_on_huge_pages(char** argv) {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
@@ -28,4 +28,4 @@ bool heap_on_huge_pages() {
   return tunables && std::string(tunables).find("glibc.malloc.hugetlb=1") != std::string::npos;
 }
 
-}  // namespace bodyfit::cli
+}  // namespace bodyfit
