@@ -8,9 +8,12 @@
 #include <bodyfit/io.hpp>
 #include <bodyfit/projection.hpp>
 
+#include <tbb/global_control.h>
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -124,4 +127,42 @@ TEST_CASE("ReferenceSurface::closest among triangles of very different sizes, an
   quad(Vec3(11, 0, 1e-3), Vec3(1, 0, 0), Vec3(0, 1, 0), 7);     // a second sheet 1e-3 above
   quad(Vec3(0, 0, 2), Vec3(10, 0, 0), Vec3(0, 10, 0), 25);      // a parallel plane above the big one
   check_nearest(mesh, 1800);
+}
+
+TEST_CASE("ReferenceSurface: the same bits with 1 and 2 threads, and deleted faces left out as in a compacted copy") {
+  // A remesh projects onto it and sizes by its curvature: its results must not depend on the
+  // thread count, nor on whether the mesh it was copied from was compacted.
+  const SurfaceMesh part = read_mesh(fs::path(BODYFIT_SOURCE_DIR) / "meshes/public/fandisk.off");
+  auto built_with = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    return std::make_unique<ReferenceSurface>(part);
+  };
+  const auto one = built_with(1), two = built_with(2);
+  CHECK(one->max_curvature() == two->max_curvature());
+  CHECK(one->max_curvature() > 0);
+  int same = 0;
+  for (auto v : part.vertices()) {
+    const Vec3 p = part.point(v) + Vec3(1e-3, -2e-3, 3e-3);
+    same += one->smooth_normal(p) == two->smooth_normal(p) && one->closest(p).point == two->closest(p).point;
+  }
+  CHECK(same == int(part.n_vertices()));
+
+  // A third of the faces deleted (not collected): the reference is made of the others.
+  SurfaceMesh holes = part;
+  for (auto f : holes.faces())
+    if (f.idx() % 3 == 0) holes.delete_face(f, true);
+  SurfaceMesh compact = holes;
+  compact.garbage_collection();
+  const ReferenceSurface with_deleted(holes), compacted(compact);
+  REQUIRE(with_deleted.n_triangles() == compact.n_faces());
+  CHECK(with_deleted.max_curvature() == doctest::Approx(compacted.max_curvature()).epsilon(1e-12));
+  // The same distances off S, and at S's vertices the same smooth normals (elsewhere a point halfway
+  // between two sheets may take either).
+  double worst = 0;
+  for (auto v : compact.vertices()) {
+    const Vec3 at = compact.point(v), p = at + Vec3(2e-3, 1e-3, -1e-3);
+    worst = std::max({worst, std::abs((with_deleted.closest(p).point - p).norm() - (compacted.closest(p).point - p).norm()),
+                      (with_deleted.smooth_normal(at) - compacted.smooth_normal(at)).norm()});
+  }
+  CHECK(worst < 1e-12);
 }
