@@ -63,6 +63,13 @@ class Locator {
   void reserve(std::size_t n) {
     if (!binary_ && !none_) lines_.reserve(n);
   }
+  /// n records, one per line from `first`.
+  void push_lines(long first, std::size_t n) {
+    if (binary_ || none_) return;
+    const std::size_t at = lines_.size();
+    lines_.resize(at + n);
+    for (std::size_t i = 0; i < n; ++i) lines_[at + i] = static_cast<std::uint32_t>(first + long(i));
+  }
   /// The error for record i: "<file>:<line>: what", "<file>: byte N: what" or "<file>: what".
   InputError error(const std::filesystem::path& file, std::size_t i, const std::string& what) const;
 

@@ -1,6 +1,7 @@
 // Medit / GMF meshes: .mesh (text) and .meshb (binary), read into MeshRecords and written from a
 // SurfaceMesh with the edges MMG must keep. The format itself is in medit_format.hpp.
 #include "medit_format.hpp"
+#include "text_records.hpp"
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/guards.hpp>
@@ -94,6 +95,36 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
     }
     in.set_context(nullptr, 0, 0);
   };
+  // A section of records, each some `numbers` and a ref, appended to `items` and `refs`:
+  // `record(scanner, i)` reads item i. By every thread when they are one per line.
+  auto read_section = [&](const char* section, int numbers, auto& items, BulkVector<int>& refs, Locator& lines,
+                          auto&& record) {
+    const std::int64_t n = count_of(section);
+    const std::size_t at = items.size();
+    if (n >= kParallelRecords) {
+      const long first_line = (in.skip_blank(), in.line());
+      items.resize(at + std::size_t(n));
+      refs.resize(at + std::size_t(n));
+      if (read_lines_in_parallel(in, n, file,
+                                 [&](TextScanner& scanner, std::int64_t i) { record(scanner, at + std::size_t(i)); })) {
+        lines.push_lines(first_line, std::size_t(n));
+        return;
+      }
+      items.resize(at);
+      refs.resize(at);
+    }
+    items.reserve(at + room(n, numbers));
+    refs.reserve(at + room(n, numbers));
+    lines.reserve(at + room(n, numbers));
+    for (std::int64_t i = 0; i < n; ++i) {
+      in.set_context(section, i, n);
+      in.skip_blank();
+      lines.push_line(in.line());
+      items.emplace_back();
+      refs.emplace_back();
+      record(in, at + std::size_t(i));
+    }
+  };
   while (!ended) {
     if (!in.skip_blank()) break;
     const std::string_view word = in.keyword("records");
@@ -103,48 +134,24 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
       header.dimension = int(in.integer("the dimension"));
       check_dimension(header.dimension, [&](const std::string& w) { return in.error(w); });
     } else if (word == "Vertices") {
-      auto n = count_of("Vertices");
-      r.points.reserve(room(n, header.dimension + 1));
-      r.vertex_refs.reserve(room(n, header.dimension + 1));
-      r.vertex_at.reserve(room(n, header.dimension + 1));
-      for (std::int64_t i = 0; i < n; ++i) {
-        in.set_context("Vertices", i, n);
-        in.skip_blank();
-        r.vertex_at.push_line(in.line());
-        Vec3 p(0, 0, 0);
-        p[0] = in.real("the x coordinate");
-        p[1] = in.real("the y coordinate");
-        if (header.dimension == 3) p[2] = in.real("the z coordinate");
-        r.points.push_back(p);
-        r.vertex_refs.push_back(in.reference("the vertex ref"));
-      }
+      read_section("Vertices", header.dimension + 1, r.points, r.vertex_refs, r.vertex_at,
+                   [&](TextScanner& scanner, std::size_t i) {
+                     Vec3& p = r.points[i];
+                     p[0] = scanner.real("the x coordinate");
+                     p[1] = scanner.real("the y coordinate");
+                     p[2] = header.dimension == 3 ? scanner.real("the z coordinate") : 0.0;
+                     r.vertex_refs[i] = scanner.reference("the vertex ref");
+                   });
     } else if (word == "Triangles") {
-      auto n = count_of("Triangles");
-      r.triangles.reserve(room(n, 4));
-      r.triangle_refs.reserve(room(n, 4));
-      r.triangle_at.reserve(room(n, 4));
-      for (std::int64_t i = 0; i < n; ++i) {
-        in.set_context("Triangles", i, n);
-        in.skip_blank();
-        r.triangle_at.push_line(in.line());
-        std::array<std::int64_t, 3> t{};
-        for (auto& v : t) v = zero_based(in.integer("a vertex index"));
-        r.triangles.push_back(t);
-        r.triangle_refs.push_back(in.reference("the triangle ref"));
-      }
+      read_section("Triangles", 4, r.triangles, r.triangle_refs, r.triangle_at, [&](TextScanner& scanner, std::size_t i) {
+        for (auto& v : r.triangles[i]) v = zero_based(scanner.integer("a vertex index"));
+        r.triangle_refs[i] = scanner.reference("the triangle ref");
+      });
     } else if (word == "Edges") {
-      auto n = count_of("Edges");
-      r.edges.reserve(room(n, 3));
-      r.edge_refs.reserve(room(n, 3));
-      for (std::int64_t i = 0; i < n; ++i) {
-        in.set_context("Edges", i, n);
-        in.skip_blank();
-        r.edge_at.push_line(in.line());
-        std::array<std::int64_t, 2> e{};
-        for (auto& v : e) v = zero_based(in.integer("a vertex index"));
-        r.edges.push_back(e);
-        r.edge_refs.push_back(in.reference("the edge ref"));
-      }
+      read_section("Edges", 3, r.edges, r.edge_refs, r.edge_at, [&](TextScanner& scanner, std::size_t i) {
+        for (auto& v : r.edges[i]) v = zero_based(scanner.integer("a vertex index"));
+        r.edge_refs[i] = scanner.reference("the edge ref");
+      });
     } else if (word == "Corners") {
       index_list("Corners", r.corners, r.corner_at);
     } else if (word == "RequiredVertices") {

@@ -1,6 +1,7 @@
 // Medit / GMF solutions: .sol (text) and .solb (binary), the fields at the vertices of a mesh.
 // The format itself is in medit_format.hpp.
 #include "medit_format.hpp"
+#include "text_records.hpp"
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/guards.hpp>
@@ -71,10 +72,23 @@ SolRead read_sol_text(std::string_view text, const fs::path& file) {
       std::vector<int> types;
       for (std::int64_t k = 0; k < ntypes; ++k) types.push_back(int(in.integer("a solution type")));
       result.fields = make_fields(types, dimension, n, [&](const std::string& w) { return in.error(w); });
-      for (std::int64_t i = 0; i < n; ++i) {
-        in.set_context("SolAtVertices", i, n);
+      auto read_values = [&](TextScanner& scanner, std::int64_t i) {
         for (auto& f : result.fields)
-          for (int k = 0; k < f.dimension; ++k) f.values.push_back(in.real("a solution value"));
+          for (int k = 0; k < f.dimension; ++k)
+            f.values[std::size_t(i) * std::size_t(f.dimension) + std::size_t(k)] = scanner.real("a solution value");
+      };
+      bool read = false;
+      if (n >= kParallelRecords) {
+        in.skip_blank();
+        for (auto& f : result.fields) f.values.resize(std::size_t(n) * std::size_t(f.dimension));
+        read = read_lines_in_parallel(in, n, file, read_values);
+        if (!read)
+          for (auto& f : result.fields) f.values.clear();
+      }
+      for (std::int64_t i = 0; i < n && !read; ++i) {
+        in.set_context("SolAtVertices", i, n);
+        for (auto& f : result.fields) f.values.resize(f.values.size() + std::size_t(f.dimension));
+        read_values(in, i);
       }
       in.set_context(nullptr, 0, 0);
     } else if (word == "End") {

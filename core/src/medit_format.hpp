@@ -60,8 +60,8 @@ enum Keyword : int {
 
 class TextScanner {
  public:
-  TextScanner(std::string_view text, const std::filesystem::path& file)
-      : p_(text.data()), end_(text.data() + text.size()), file_(file) {}
+  TextScanner(std::string_view text, const std::filesystem::path& file, long first_line = 1)
+      : p_(text.data()), end_(text.data() + text.size()), file_(file), line_(first_line) {}
 
   /// Skip whitespace and comments; true when a token follows.
   bool skip_blank() {
@@ -82,6 +82,13 @@ class TextScanner {
   }
   long line() const { return line_; }
   std::size_t remaining() const { return std::size_t(end_ - p_); }
+  /// The text from here to the end.
+  std::string_view rest() const { return {p_, remaining()}; }
+  /// Continue at `position` (in the rest), which is on line `line`.
+  void jump_to(const char* position, long line) {
+    p_ = position;
+    line_ = line;
+  }
 
   std::string_view word() {
     if (!skip_blank()) return {};
