@@ -1,4 +1,5 @@
 // Mesh I/O: format dispatch and the validated builder shared by every reader.
+#include "blocks.hpp"
 #include "io_internal.hpp"
 #include "mesh_connectivity.hpp"
 
@@ -19,6 +20,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <new>
 
@@ -216,50 +218,75 @@ MeshRecords merge_coincident_vertices(const MeshRecords& r, std::size_t& merged)
   return out;
 }
 
+namespace {
+/// The first i in [0, n) for which bad(i) holds, or n.
+template <class Bad>
+int first_where(int n, Bad&& bad) {
+  return reduce(
+      n, n, [&](int i, int& first) { if (i < first && bad(i)) first = i; },
+      [](int& first, int other) { first = std::min(first, other); });
+}
+}  // namespace
+
 SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const ReadOptions& options) {
+  // Every check runs in parallel and names the first record that fails it, as a loop would.
   const std::int64_t nv = static_cast<std::int64_t>(r.points.size());
-  for (std::size_t i = 0; i < r.points.size(); ++i) {
+  const int bad_vertex = first_where(int(nv), [&](int i) {
+    const auto& p = r.points[std::size_t(i)];
+    return !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) ||
+           std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) > kMaxCoordinate;
+  });
+  if (bad_vertex < nv) {
+    const auto i = std::size_t(bad_vertex);
     const auto& p = r.points[i];
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       throw r.vertex_at.error(file, i, fmt::format("vertex {} has a NaN or infinite coordinate", i + 1));
-    if (std::max({std::abs(p[0]), std::abs(p[1]), std::abs(p[2])}) > kMaxCoordinate)
-      throw r.vertex_at.error(file, i,
-                              fmt::format("vertex {} ({:.3g}, {:.3g}, {:.3g}) is beyond ±{:.0e}: its squared lengths and "
-                                          "areas would overflow",
-                                          i + 1, p[0], p[1], p[2], kMaxCoordinate));
+    throw r.vertex_at.error(file, i,
+                            fmt::format("vertex {} ({:.3g}, {:.3g}, {:.3g}) is beyond ±{:.0e}: its squared lengths and "
+                                        "areas would overflow",
+                                        i + 1, p[0], p[1], p[2], kMaxCoordinate));
   }
   if (r.triangles.empty())
     throw file_error(file, fmt::format("no triangles ({} vertices): not a surface mesh, or a truncated or "
                                        "malformed file",
                                        r.points.size()));
+  if (r.triangles.size() > std::size_t(std::numeric_limits<int>::max() / 3))
+    throw file_error(file, fmt::format("{} triangles: more than a mesh can hold ({})", r.triangles.size(),
+                                       std::numeric_limits<int>::max() / 3));
 
   // Indices, degenerate triangles and the mesh scale.
-  double length_sum = 0;
-  for (std::size_t t = 0; t < r.triangles.size(); ++t) {
+  const int nt = int(r.triangles.size());
+  const int bad_triangle = first_where(nt, [&](int t) {
+    const auto& tri = r.triangles[std::size_t(t)];
+    for (auto i : tri)
+      if (i < 0 || i >= nv) return true;
+    return tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
+  });
+  if (bad_triangle < nt) {
+    const auto t = std::size_t(bad_triangle);
     const auto& tri = r.triangles[t];
     for (auto i : tri)
       if (i < 0 || i >= nv)
         throw r.triangle_at.error(file, t,
                                   fmt::format("triangle {} refers to vertex {}, expected an index in 1..{}", t + 1,
                                               i + 1, nv));
-    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
-      throw r.triangle_at.error(file, t, fmt::format("triangle {} uses the same vertex twice", t + 1));
-    for (int k = 0; k < 3; ++k) length_sum += (r.points[tri[(k + 1) % 3]] - r.points[tri[k]]).norm();
+    throw r.triangle_at.error(file, t, fmt::format("triangle {} uses the same vertex twice", t + 1));
   }
-  if (!r.triangles.empty()) {
-    const double mean_length = length_sum / (3.0 * double(r.triangles.size()));
-    const double min_area = options.min_relative_area * mean_length * mean_length;
-    for (std::size_t t = 0; t < r.triangles.size(); ++t) {
-      const auto& tri = r.triangles[t];
-      const double area =
-          0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
-      if (!(area > min_area))
-        throw r.triangle_at.error(
-            file, t,
-            fmt::format("triangle {} has zero area ({:.3g}, below {:.3g} x mean edge length^2)", t + 1, area,
-                        options.min_relative_area));
-    }
-  }
+  auto side = [&](int k) {  // side k % 3 of triangle k / 3
+    const auto& tri = r.triangles[std::size_t(k / 3)];
+    return (r.points[std::size_t(tri[(k + 1) % 3])] - r.points[std::size_t(tri[k % 3])]).norm();
+  };
+  const double mean_length = sum_in_order(3 * nt, side) / (3.0 * double(nt));
+  const double min_area = options.min_relative_area * mean_length * mean_length;
+  auto area = [&](int t) {
+    const auto& tri = r.triangles[std::size_t(t)];
+    return 0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
+  };
+  const int flat = first_where(nt, [&](int t) { return !(area(t) > min_area); });
+  if (flat < nt)
+    throw r.triangle_at.error(file, std::size_t(flat),
+                              fmt::format("triangle {} has zero area ({:.3g}, below {:.3g} x mean edge length^2)",
+                                          flat + 1, area(flat), options.min_relative_area));
 
   SurfaceMesh mesh;
   mesh.reserve(r.points.size(), r.points.size() + r.triangles.size(), r.triangles.size());
@@ -274,8 +301,8 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   });
   // The connectivity in a few array passes; triangle by triangle only to say what is wrong.
   if (build_connectivity(mesh, {r.triangles.data(), r.triangles.size()})) {
-    for (std::size_t t = 0; t < r.triangles.size() && t < r.triangle_refs.size(); ++t)
-      mesh.region(FaceHandle(int(t))) = r.triangle_refs[t];
+    for_each_index(int(std::min(r.triangles.size(), r.triangle_refs.size())),
+                   [&](int t) { mesh.region(FaceHandle(t)) = r.triangle_refs[std::size_t(t)]; });
   } else {
     SilenceOpenMeshErrors silence;
     for (std::size_t t = 0; t < r.triangles.size(); ++t) {
@@ -293,9 +320,8 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
         throw r.triangle_at.error(file, t, fmt::format("triangle {}: {}", t + 1, diagnose_refused_triangle(mesh, v)));
       mesh.region(f) = t < r.triangle_refs.size() ? r.triangle_refs[t] : 0;
     }
-  }
-  // A vertex where two fans touch has two outgoing boundary halfedges (OpenMesh accepts it).
-  {
+    // A vertex where two fans touch has two outgoing boundary halfedges (add_face accepts it;
+    // build_connectivity refuses it).
     std::vector<char> boundary_out(mesh.n_vertices(), 0);
     for (auto h : mesh.halfedges()) {
       if (!mesh.is_boundary(h)) continue;
@@ -350,15 +376,16 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
 
   // The interface: edges listed with ref 10, and edges between an inside and a non-inside face.
   if (mesh.has_regions()) {
-    for (auto e : mesh.edges()) {
-      if (mesh.is_boundary(e)) continue;
+    for_each_index(int(mesh.n_edges()), [&](int i) {
+      const EdgeHandle e(i);
+      if (mesh.is_boundary(e)) return;
       auto f0 = mesh.face_handle(mesh.halfedge_handle(e, 0));
       auto f1 = mesh.face_handle(mesh.halfedge_handle(e, 1));
       if (mesh.inside(f0) != mesh.inside(f1)) {
         mesh.interface(e) = 1;
         if (mesh.edge_ref(e) == 0) mesh.edge_ref(e) = kInterfaceRef;
       }
-    }
+    });
   }
 
   // Last (after the more specific checks above): every vertex is a corner. A stray one would
@@ -366,12 +393,12 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   // being part of the surface. Refused rather than dropped: dropping it would renumber the
   // vertices, and a .sol written for this mesh would no longer match.
   {
-    std::vector<char> used(r.points.size(), 0);
-    for (const auto& tri : r.triangles)
-      for (auto i : tri) used[std::size_t(i)] = 1;
-    const auto unused = std::size_t(std::count(used.begin(), used.end(), 0));
-    if (unused > 0) {
-      const auto first = std::size_t(std::find(used.begin(), used.end(), 0) - used.begin());
+    const int isolated = first_where(int(nv), [&](int v) { return mesh.is_isolated(VertexHandle(v)); });
+    if (isolated < nv) {
+      const auto first = std::size_t(isolated);
+      const int unused = reduce(
+          int(nv), 0, [&](int v, int& count) { count += mesh.is_isolated(VertexHandle(v)); },
+          [](int& count, int other) { count += other; });
       throw r.vertex_at.error(file, first,
                               fmt::format("vertex {} is not a corner of any triangle ({} such vertices): it would "
                                           "stretch the bounding box and so the default sizes; remove it",
@@ -386,9 +413,10 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
   // fans that touch at a point: merged, the point would join separate fans), the vertices are kept
   // apart, as those tools do too: the surface touches itself there, which a warning says.
   {
-    std::vector<int> boundary;
-    for (auto v : mesh.vertices())
-      if (mesh.is_boundary(v)) boundary.push_back(v.idx());
+    std::vector<int> boundary = collect<int>(int(nv), [&](int v, int& item) {
+      item = v;
+      return mesh.is_boundary(VertexHandle(v));
+    });
     auto key = [&](int v) {
       const Vec3& p = mesh.point(VertexHandle(v));
       return std::array<double, 4>{p[0], p[1], p[2], double(v)};
