@@ -10,6 +10,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -48,8 +49,8 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 
 /// A sphere with refs, regions, an interface, ridges, required and corner tags, and coordinates
 /// that need every digit: last-bit perturbations, -0, subnormals and values far from 1.
-SurfaceMesh awkward_sphere() {
-  SurfaceMesh mesh = make_sphere({.faces = 2000});
+SurfaceMesh awkward_sphere(std::size_t faces = 2000) {
+  SurfaceMesh mesh = make_sphere({.faces = faces});
   std::mt19937_64 rng(42);
   const double tiny[] = {-0.0, 4.9406564584124654e-324, -2.2250738585072009e-310, 1e-300, 0.1 + 0.2 - 0.3};
   std::size_t k = 0;
@@ -460,4 +461,110 @@ TEST_CASE("text errors name the file and the line") {
   write_bytes(dir / "e.sol", "MeshVersionFormatted 2\nDimension 3\nSolAtVertices\n2\n1 1\n0.5\n1e\n");
   m = error_of([&] { read_sol(dir / "e.sol"); });
   CHECK(m.find("e.sol:7: malformed number '1e' in SolAtVertices (record 2 of 2)") != std::string::npos);
+}
+
+TEST_CASE("large text sections are read by both threads: the same mesh, and any other layout or error as on one") {
+  // Sections of 16384 records or more, one per line, are shared between the threads; a comment or a
+  // blank line among them, a record over two lines or two on one, and every error go back to the
+  // reading on one thread, with the same result and the same message.
+  TempDir dir("io-fast-text-parallel");
+  const SurfaceMesh mesh = awkward_sphere(40000);
+  const std::string vertices = std::to_string(mesh.n_vertices()), faces = std::to_string(mesh.n_faces());
+  write_mesh(mesh, dir / "a.mesh");
+  const std::string text = test::read_file(dir / "a.mesh");
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    check_same_mesh(mesh, read_mesh(dir / "a.mesh"));
+  }
+  // Where record k of a section starts (its keyword's line, then the count's, then the records).
+  auto record_at = [&](const std::string& section, int k) {
+    std::size_t at = text.find("\n" + section + "\n") + section.size() + 2;
+    for (int line = 0; line <= k; ++line) at = text.find('\n', at) + 1;
+    return at;
+  };
+  auto line_of = [&](const std::string& t, std::size_t at) { return 1 + std::count(t.begin(), t.begin() + long(at), '\n'); };
+  auto with = [&](std::size_t at, std::size_t erase, const std::string& insert) {
+    std::string changed = text;
+    changed.replace(at, erase, insert);
+    return changed;
+  };
+  auto read_text = [&](const std::string& t) {
+    write_bytes(dir / "b.mesh", t);
+    return read_mesh(dir / "b.mesh");
+  };
+  const std::size_t vertex = record_at("Vertices", 12000), triangle = record_at("Triangles", 30000);
+  const std::size_t vertex_ref = text.rfind(' ', text.find('\n', vertex));  // before the ref
+  const std::size_t triangle_end = text.find('\n', triangle);
+  for (const std::string& layout :
+       {with(vertex, 0, "# a comment among the vertices\n"), with(triangle, 0, "\n"),
+        with(vertex_ref, 1, "\n"), with(triangle_end, 1, " ")})
+    check_same_mesh(mesh, read_text(layout));
+
+  // Errors: the line counted here in the text.
+  const std::string bad_vertex = with(vertex, 1, "0x1");
+  std::string m = error_of([&] { read_text(bad_vertex); });
+  INFO(m);
+  CHECK(m.find("b.mesh:" + std::to_string(line_of(bad_vertex, vertex)) + ": malformed number '0x1") !=
+        std::string::npos);
+  CHECK(m.find("in Vertices (record 12001 of " + vertices + "): expected the x coordinate") != std::string::npos);
+  const std::string bad_triangle = with(triangle, 0, "x");
+  m = error_of([&] { read_text(bad_triangle); });
+  CHECK(m.find("b.mesh:" + std::to_string(line_of(bad_triangle, triangle)) + ":") != std::string::npos);
+  CHECK(m.find("malformed number 'x") != std::string::npos);
+  CHECK(m.find("in Triangles (record 30001 of " + faces + "): expected a vertex index") != std::string::npos);
+  // A count larger than the records: the next section's keyword is read as a record.
+  const std::size_t count = text.find("\nTriangles\n") + 11;
+  const std::string more_faces = std::to_string(mesh.n_faces() + 1);
+  const std::string more = with(count, text.find('\n', count) - count, more_faces);
+  m = error_of([&] { read_text(more); });
+  CHECK(m.find("in Triangles (record " + more_faces + " of " + more_faces + "): expected a vertex index") !=
+        std::string::npos);
+}
+
+TEST_CASE("a large .sol is read by both threads: bit-exact values, and any other layout or error as on one") {
+  TempDir dir("io-fast-sol-parallel");
+  const std::size_t n = 20000;
+  std::mt19937_64 rng(5);
+  SolField scalar{"", 1, {}}, vector{"", 3, {}};
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t bits = rng();
+    double x;
+    std::memcpy(&x, &bits, 8);
+    scalar.values.push_back(std::isfinite(x) ? x : double(i));
+    for (int k = 0; k < 3; ++k) vector.values.push_back(double(rng() % 1000003) / 7.0 - 1e5);
+  }
+  write_sol(dir / "f.sol", {scalar, vector});
+  const std::string text = test::read_file(dir / "f.sol");
+  auto check_values = [&](const std::vector<SolField>& back) {
+    REQUIRE(back.size() == 2);
+    for (std::size_t i = 0; i < scalar.values.size(); ++i) REQUIRE(same_bits(back[0].values[i], scalar.values[i]));
+    for (std::size_t i = 0; i < vector.values.size(); ++i) REQUIRE(same_bits(back[1].values[i], vector.values[i]));
+  };
+  check_values(read_sol_all(dir / "f.sol", n));
+  // Vertex k's line: the last n lines before "End" hold the values.
+  const std::size_t values_start = [&] {
+    std::size_t at = text.find("SolAtVertices");
+    for (int line = 0; line < 3; ++line) at = text.find('\n', at) + 1;  // keyword, count, types
+    while (text[at] == '\n') ++at;                                      // blank lines
+    return at;
+  }();
+  auto record_at = [&](std::size_t k) {
+    std::size_t at = values_start;
+    for (std::size_t line = 0; line < k; ++line) at = text.find('\n', at) + 1;
+    return at;
+  };
+  REQUIRE(text.compare(record_at(n), 4, "\nEnd") == 0);  // one line per vertex
+  const std::size_t at = record_at(15000);
+  std::string commented = text;
+  commented.insert(at, "# a comment\n");
+  write_bytes(dir / "g.sol", commented);
+  check_values(read_sol_all(dir / "g.sol", n));
+  std::string bad = text;
+  bad.insert(at, "x");
+  write_bytes(dir / "h.sol", bad);
+  const std::string m = error_of([&] { read_sol_all(dir / "h.sol", n); });
+  INFO(m);
+  const long line = 1 + std::count(bad.begin(), bad.begin() + long(at), '\n');
+  CHECK(m.find("h.sol:" + std::to_string(line) + ": malformed number 'x") != std::string::npos);
+  CHECK(m.find("in SolAtVertices (record 15001 of 20000)") != std::string::npos);
 }
