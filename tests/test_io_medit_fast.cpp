@@ -10,6 +10,7 @@
 #include "test_support.hpp"
 
 #include <doctest/doctest.h>
+#include <fmt/format.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -567,4 +569,57 @@ TEST_CASE("a large .sol is read by both threads: bit-exact values, and any other
   const long line = 1 + std::count(bad.begin(), bad.begin() + long(at), '\n');
   CHECK(m.find("h.sol:" + std::to_string(line) + ": malformed number 'x") != std::string::npos);
   CHECK(m.find("in SolAtVertices (record 15001 of 20000)") != std::string::npos);
+}
+
+TEST_CASE("a large mesh's checks name its first bad record, whichever block of the parallel checks finds it") {
+  // 40k triangles: the checks run over several blocks; the one named is the first in the file.
+  TempDir dir("io-fast-first-bad");
+  write_mesh(make_sphere({.faces = 40000}), dir / "a.mesh");
+  std::vector<std::string> lines;
+  {
+    std::istringstream in(test::read_file(dir / "a.mesh"));
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  const auto keyword = [&](const std::string& word) {
+    return std::size_t(std::find(lines.begin(), lines.end(), word) - lines.begin());
+  };
+  const std::size_t vertex0 = keyword("Vertices") + 2, triangle0 = keyword("Triangles") + 2;
+  auto numbers = [&](std::size_t line) {
+    std::istringstream in(lines[line]);
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    return words;
+  };
+  auto error_with = [&](const std::vector<std::pair<std::size_t, std::string>>& changes) {
+    std::vector<std::string> changed = lines;
+    for (const auto& [line, text] : changes) changed[line] = text;
+    std::string text;
+    for (const auto& line : changed) text += line + "\n";
+    write_bytes(dir / "b.mesh", text);
+    return error_of([&] { read_mesh(dir / "b.mesh"); });
+  };
+  auto triangle = [&](std::size_t t, int k) { return std::stoll(numbers(triangle0 + t)[std::size_t(k)]); };
+  // The same vertex twice in triangle 30001, a vertex out of range in triangle 35001.
+  std::string m = error_with({{triangle0 + 30000, fmt::format("{0} {0} {1} 0", triangle(30000, 0), triangle(30000, 2))},
+                              {triangle0 + 35000, "1 2 999999 0"}});
+  INFO(m);
+  CHECK(m.find(fmt::format("b.mesh:{}: triangle 30001 uses the same vertex twice", triangle0 + 30001)) !=
+        std::string::npos);
+  m = error_with({{triangle0 + 35000, "1 2 999999 0"}});
+  CHECK(m.find(fmt::format("b.mesh:{}: triangle 35001 refers to vertex 999999", triangle0 + 35001)) !=
+        std::string::npos);
+  // Infinite coordinates at vertices 19001 and 9001.
+  m = error_with({{vertex0 + 19000, "inf 0 0 0"}, {vertex0 + 9000, "0 nan 0 0"}});
+  CHECK(m.find(fmt::format("b.mesh:{}: vertex 9001 has a NaN or infinite coordinate", vertex0 + 9001)) !=
+        std::string::npos);
+  // Triangles 39001 and 12001 made flat: their third corner moved onto their first side's middle.
+  std::vector<std::pair<std::size_t, std::string>> flat;
+  for (std::size_t t : {std::size_t(39000), std::size_t(12000)}) {
+    const auto a = numbers(vertex0 + std::size_t(triangle(t, 0) - 1)), b = numbers(vertex0 + std::size_t(triangle(t, 1) - 1));
+    std::string middle;
+    for (std::size_t k = 0; k < 3; ++k) middle += fmt::format("{} ", 0.5 * (std::stod(a[k]) + std::stod(b[k])));
+    flat.push_back({vertex0 + std::size_t(triangle(t, 2) - 1), middle + "0"});
+  }
+  m = error_with(flat);
+  CHECK(m.find(fmt::format("b.mesh:{}: triangle 12001 has zero area", triangle0 + 12001)) != std::string::npos);
 }
