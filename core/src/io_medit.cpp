@@ -101,7 +101,9 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
                           auto&& record) {
     const std::int64_t n = count_of(section);
     const std::size_t at = items.size();
-    if (n >= kParallelRecords) {
+    // Sized at once only for as many records as the rest of the file can hold (as `room`): a count
+    // beyond is an error the loop below reports.
+    if (n >= kParallelRecords && std::size_t(n) <= in.remaining() / (2 * std::size_t(numbers))) {
       const long first_line = (in.skip_blank(), in.line());
       items.resize(at + std::size_t(n));
       refs.resize(at + std::size_t(n));

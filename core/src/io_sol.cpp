@@ -78,7 +78,9 @@ SolRead read_sol_text(std::string_view text, const fs::path& file) {
             f.values[std::size_t(i) * std::size_t(f.dimension) + std::size_t(k)] = scanner.real("a solution value");
       };
       bool read = false;
-      if (n >= kParallelRecords) {
+      std::size_t numbers = 0;  // per vertex
+      for (const auto& f : result.fields) numbers += std::size_t(f.dimension);
+      if (n >= kParallelRecords && std::size_t(n) <= in.remaining() / (2 * numbers)) {  // what the file can hold
         in.skip_blank();
         for (auto& f : result.fields) f.values.resize(std::size_t(n) * std::size_t(f.dimension));
         read = read_lines_in_parallel(in, n, file, read_values);
