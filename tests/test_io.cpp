@@ -1388,6 +1388,15 @@ TEST_CASE("a read mesh's connectivity is add_face's, array for array: closed, op
       check_reader_builds_as_add_face(shape, corners);
     }
   }
+  SUBCASE("large enough for the sides to be sorted and numbered by several chunks, shuffled") {
+    const SurfaceMesh shape = make_sphere({.faces = 60000});  // 180k sides
+    auto corners = corners_of(shape);
+    std::vector<std::array<std::int64_t, 3>> triangles(corners.size() / 3);
+    std::memcpy(triangles.data(), corners.data(), corners.size() * sizeof(std::int64_t));
+    std::shuffle(triangles.begin(), triangles.end(), std::mt19937(11));
+    std::memcpy(corners.data(), triangles.data(), corners.size() * sizeof(std::int64_t));
+    check_reader_builds_as_add_face(shape, corners);
+  }
   SUBCASE("public meshes with boundaries, handles and creases") {
     for (const char* name : {"anchor", "elephant-with-holes", "fandisk", "knot1"}) {
       const fs::path file = fs::path(BODYFIT_SOURCE_DIR) / "meshes/public" / (std::string(name) + ".off");

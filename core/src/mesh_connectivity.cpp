@@ -5,9 +5,13 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <utility>
+#include <vector>
 
 namespace bodyfit {
 namespace {
@@ -20,6 +24,7 @@ constexpr int next_in_triangle(int k) { return k % 3 == 2 ? k - 2 : k + 1; }
 constexpr int previous_in_triangle(int k) { return k % 3 == 0 ? k + 2 : k - 1; }
 
 constexpr int kGrain = 4096;  // elements per parallel task
+constexpr int kMaxChunks = 8;  // of the counting sort (each counts over every vertex)
 
 }  // namespace
 
@@ -34,16 +39,29 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
 
   // Each vertex's outgoing corner halfedges in triangle order, and beside them where each one goes
   // (the twin search below then reads one vertex's sides from two short runs of memory).
+  // A counting sort by chunks of sides: each chunk counts its sides per vertex, and places them
+  // after those of the chunks before (the same arrays as one pass in side order).
   Array first_out(std::size_t(nv) + 1, 0), out(std::size_t(nk), 0), out_to(std::size_t(nk), 0);
-  for (int k = 0; k < nk; ++k) ++first_out[std::size_t(from(k)) + 1];
-  for (int v = 0; v < nv; ++v) first_out[std::size_t(v) + 1] += first_out[std::size_t(v)];
   {
-    Array filled(first_out.begin(), first_out.end() - 1);
-    for (int k = 0; k < nk; ++k) {
-      const auto i = std::size_t(filled[std::size_t(from(k))]++);
-      out[i] = k;
-      out_to[i] = to[std::size_t(k)];
+    const int chunks = std::clamp(std::min(nk / (16 * kGrain), tbb::this_task_arena::max_concurrency()), 1, kMaxChunks);
+    auto chunk_begin = [&](int c) { return int(std::int64_t(nk) * c / chunks); };
+    std::vector<Array> at(std::size_t(chunks), Array(std::size_t(nv), 0));  // count, then next place
+    tbb::parallel_for(0, chunks, [&](int c) {
+      for (int k = chunk_begin(c); k < chunk_begin(c + 1); ++k) ++at[std::size_t(c)][std::size_t(from(k))];
+    });
+    for (int v = 0; v < nv; ++v) {
+      int place = first_out[std::size_t(v)];
+      for (auto& counts : at) place += std::exchange(counts[std::size_t(v)], place);
+      first_out[std::size_t(v) + 1] = place;
     }
+    tbb::parallel_for(0, chunks, [&](int c) {
+      Array& next = at[std::size_t(c)];
+      for (int k = chunk_begin(c); k < chunk_begin(c + 1); ++k) {
+        const auto i = std::size_t(next[std::size_t(from(k))]++);
+        out[i] = k;
+        out_to[i] = to[std::size_t(k)];
+      }
+    });
   }
   // The checks below run in parallel over the vertices; any one failing fails the whole.
   std::atomic<bool> manifold = true;
@@ -104,12 +122,31 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
 
   // Edges numbered as add_face creates them: at a side's first use, in triangle then corner order,
   // the edge's first halfedge along that side.
+  // The sides that make an edge are counted by blocks, then numbered from their block's first
+  // number; the others take their twin's edge, the other way round.
   Array halfedge(static_cast<std::size_t>(nk), 0);
-  int ne = 0;
-  for (int k = 0; k < nk; ++k) {
+  auto makes_edge = [&](int k) {
     const int t = twin[std::size_t(k)];
-    halfedge[std::size_t(k)] = (t < 0 || t > k) ? 2 * ne++ : halfedge[std::size_t(t)] ^ 1;
-  }
+    return t < 0 || t > k;
+  };
+  const int blocks = (nk + kGrain - 1) / kGrain;
+  Array first_edge(std::size_t(blocks) + 1, 0);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    int count = 0;
+    for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k) count += makes_edge(k);
+    first_edge[std::size_t(b) + 1] = count;
+  });
+  for (int b = 0; b < blocks; ++b) first_edge[std::size_t(b) + 1] += first_edge[std::size_t(b)];
+  const int ne = first_edge[std::size_t(blocks)];
+  tbb::parallel_for(0, blocks, [&](int b) {
+    int edge = first_edge[std::size_t(b)];
+    for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k)
+      if (makes_edge(k)) halfedge[std::size_t(k)] = 2 * edge++;
+  });
+  tbb::parallel_for(0, blocks, [&](int b) {
+    for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k)
+      if (!makes_edge(k)) halfedge[std::size_t(k)] = halfedge[std::size_t(twin[std::size_t(k)])] ^ 1;
+  });
 
   mesh.resize(std::size_t(nv), std::size_t(ne), corners.size());
   // Every write below is to an element of its own (a vertex has at most one boundary side leaving
