@@ -230,6 +230,10 @@ int first_where(int n, Bad&& bad) {
 
 SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const ReadOptions& options) {
   // Every check runs in parallel and names the first record that fails it, as a loop would.
+  constexpr std::size_t kMostElements = std::numeric_limits<int>::max() / 3;  // int handles, 3 sides each
+  if (r.points.size() > kMostElements || r.triangles.size() > kMostElements)
+    throw file_error(file, fmt::format("{} vertices and {} triangles: more than a mesh can hold ({} of each)",
+                                       r.points.size(), r.triangles.size(), kMostElements));
   const std::int64_t nv = static_cast<std::int64_t>(r.points.size());
   const int bad_vertex = first_where(int(nv), [&](int i) {
     const auto& p = r.points[std::size_t(i)];
@@ -250,9 +254,6 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     throw file_error(file, fmt::format("no triangles ({} vertices): not a surface mesh, or a truncated or "
                                        "malformed file",
                                        r.points.size()));
-  if (r.triangles.size() > std::size_t(std::numeric_limits<int>::max() / 3))
-    throw file_error(file, fmt::format("{} triangles: more than a mesh can hold ({})", r.triangles.size(),
-                                       std::numeric_limits<int>::max() / 3));
 
   // Indices, degenerate triangles and the mesh scale.
   const int nt = int(r.triangles.size());
