@@ -426,15 +426,17 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     for (std::size_t k = 1; k < boundary.size(); ++k) {
       const int a = boundary[k - 1], b = boundary[k];
       if (mesh.point(VertexHandle(a)) != mesh.point(VertexHandle(b))) continue;
-      const Vec3& p = mesh.point(VertexHandle(b));
+      const Vec3 p = mesh.point(VertexHandle(b));
       std::size_t merged = 0;
       MeshRecords joined = merge_coincident_vertices(r, merged);
       try {
-        SurfaceMesh whole = build_mesh(std::move(joined), file, options);
+        // Every return names `mesh`, so that it is built in the caller's object: OpenMesh's kernel
+        // has no move constructor, and a `return` of another mesh would copy every array.
+        mesh = build_mesh(std::move(joined), file, options);
         spdlog::warn("{}: {} vertices at the same point as an earlier one (vertex {} is vertex {}, ...) merged, as MMG "
                      "and CGAL do: the surface is closed there, and its vertices are renumbered",
                      file.string(), merged, b + 1, a + 1);
-        return whole;
+        return mesh;
       } catch (const InputError& e) {
         spdlog::warn("{}: vertices {} and {} are at the same point ({:.6g}, {:.6g}, {:.6g}), both on a boundary, and "
                      "merging them would not give a surface ({}): kept apart, the surface touches itself there",
