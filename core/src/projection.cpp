@@ -165,6 +165,9 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 
 ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
   std::vector<int> index(mesh.n_vertices(), -1);
+  points_.reserve(mesh.n_vertices());
+  tri_.reserve(mesh.n_faces());
+  normal_.reserve(mesh.n_faces());
   for (auto v : mesh.vertices()) {
     index[v.idx()] = int(points_.size());
     points_.push_back(mesh.point(v));

@@ -226,6 +226,8 @@ void Remesher::split_long_edges() {
       for (auto h : m_.voh_range(v)) edges_.push_back(m_.edge_handle(h));
     flip_in_order(edges_);
   }
+  // The first round's projections fill tens of MB the passes would otherwise grow the heap beside.
+  release_buffers(projected_);
 }
 
 // One collapse/flip/relocate pass over the work queue (with a split step for edges made long since);

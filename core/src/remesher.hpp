@@ -29,6 +29,7 @@
 #include <optional>
 #include <queue>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace bodyfit::remesh_detail {
@@ -161,6 +162,16 @@ class Remesher {
     m_.remove_property(depth_);
     m_.remove_property(touched_);
     m_.remove_property(ecurve_);
+    // The scratch buffers and the search trees too (a remesh to a size leaves tens of MB in them):
+    // the compaction that follows reuses that memory instead of growing the heap.
+    ref_.reset();
+    curves_ = ReferencePolyline();
+    release_buffers(work_, next_, touched_list_, edges_, ranked_, rated_, projected_, worth_flipping_, face_flipped_,
+                    flipped_faces_, star_, after_, normals_);
+  }
+  template <class... Vectors>
+  static void release_buffers(Vectors&... vectors) {
+    ((void)std::exchange(vectors, Vectors()), ...);
   }
   Remesher(const Remesher&) = delete;
   Remesher& operator=(const Remesher&) = delete;
