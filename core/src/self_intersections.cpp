@@ -3,17 +3,19 @@
 
 #include <bodyfit/geometry.hpp>
 
+#include "blocks.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 namespace bodyfit {
 
@@ -210,35 +212,51 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) { visit(cell_key(i, j, k)); });
   };
 
-  std::vector<Triangle> tris;
-  std::vector<int> face_of;   // the face of each triangle
-  std::vector<char> flagged;  // the triangle's face is one of `near`
-  auto add = [&](int f) {
-    Triangle t;
-    const auto vs = face_vertices(surface, FaceHandle(f));
-    for (int i = 0; i < 3; ++i) t.v[i] = vs[i].idx(), t.p[i] = surface.point(vs[i]);
-    const Vec3 n = OpenMesh::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
-    const double len = n.norm();
-    t.normal = len > 0 ? n / len : Vec3(0, 0, 0);
-    bounds(t.p, t.lo, t.hi);
-    tris.push_back(t);
-    face_of.push_back(f);
-    flagged.push_back(is_flagged(f));
+  // The faces searched: the flagged ones in face order, then (with `near`) the others that share a
+  // grid cell with a flagged one, in face order; triangle i is faces[i].
+  std::vector<int> faces = collect<int>(nf, [&](int f, int& item) {
+    item = f;
+    return !surface.status(FaceHandle(f)).deleted() && is_flagged(f);
+  });
+  const std::size_t n_flagged = faces.size();
+  auto box_of = [&](int f, Vec3& lo, Vec3& hi) { bounds(corners(f), lo, hi); };
+  // The cells the flagged triangles occupy, each with its triangles, as (cell, triangle) pairs:
+  // made in parallel (a count per triangle, then its slots), sorted by cell then triangle.
+  using Entry = std::pair<std::uint64_t, int>;
+  auto cell_entries = [&](std::size_t first, std::size_t count, auto&& boxes, auto&& keep) {
+    std::vector<std::size_t> offset(count + 1, 0);
+    tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
+      Vec3 lo, hi;
+      boxes(first + i, lo, hi);
+      std::size_t n = 0;
+      for_cells(lo, hi, [&](std::uint64_t key) { n += keep(key); });
+      offset[i + 1] = n;
+    });
+    for (std::size_t i = 0; i < count; ++i) offset[i + 1] += offset[i];
+    std::vector<Entry> entries(offset[count]);
+    tbb::parallel_for(std::size_t(0), count, [&](std::size_t i) {
+      Vec3 lo, hi;
+      boxes(first + i, lo, hi);
+      std::size_t at = offset[i];
+      for_cells(lo, hi, [&](std::uint64_t key) {
+        if (keep(key)) entries[at++] = {key, int(first + i)};
+      });
+    });
+    return entries;
   };
-  // Each pair is tested once, in the cell holding the lower corner of their boxes' overlap. The
-  // flagged triangles first; then the others, into the cells the flagged ones occupy only (found in
-  // parallel, added in face order).
-  std::unordered_map<std::uint64_t, std::vector<int>> grid;
-  for (int f = 0; f < nf; ++f) {
-    if (surface.status(FaceHandle(f)).deleted() || !is_flagged(f)) continue;
-    add(f);
-    const Triangle& t = tris.back();
-    const int id = int(tris.size()) - 1;
-    for_cells(t.lo, t.hi, [&](std::uint64_t key) { grid[key].push_back(id); });
-  }
+  std::vector<Entry> grid = cell_entries(0, n_flagged, [&](std::size_t i, Vec3& lo, Vec3& hi) { box_of(faces[i], lo, hi); },
+                                         [](std::uint64_t) { return true; });
+  tbb::parallel_sort(grid.begin(), grid.end());
   if (near) {
     // The cells the flagged triangles occupy, as a table over the box's cells (one more on each
-    // side for the tolerance) when it is small: the sweep below looks them up without hashing.
+    // side for the tolerance) when it is small, else their sorted keys: the sweep below looks the
+    // others' cells up in it.
+    std::vector<std::uint64_t> flagged_cells(grid.size());
+    for (std::size_t k = 0; k < grid.size(); ++k) flagged_cells[k] = grid[k].first;
+    flagged_cells.erase(std::unique(flagged_cells.begin(), flagged_cells.end()), flagged_cells.end());
+    auto is_flagged_cell = [&](std::uint64_t key) {
+      return std::binary_search(flagged_cells.begin(), flagged_cells.end(), key);
+    };
     const std::int64_t nx = index(box.max[0], box.min[0]) + 3, ny = index(box.max[1], box.min[1]) + 3,
                        nz = index(box.max[2], box.min[2]) + 3;
     auto in_table = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -251,16 +269,19 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     bool whole_table = nx > 0 && ny > 0 && nz > 0 && nx * ny * nz <= (std::int64_t(1) << 26);
     if (whole_table) {
       occupied.assign(std::size_t(nx * ny * nz), 0);
-      for (const Triangle& t : tris)
-        for_cell_indices(t.lo, t.hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-          if (in_table(i, j, k)) occupied[cell_of(i, j, k)] = 1;
-          else whole_table = false;  // not expected (every triangle is in the box): the grid then
+      for (std::size_t i = 0; i < n_flagged && whole_table; ++i) {
+        Vec3 lo, hi;
+        box_of(faces[i], lo, hi);
+        for_cell_indices(lo, hi, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
+          if (in_table(x, y, z)) occupied[cell_of(x, y, z)] = 1;
+          else whole_table = false;  // not expected (every triangle is in the box): the keys then
         });
+      }
     }
     auto meets_flagged = [&](const Vec3& lo, const Vec3& hi) {
       bool meets = false;
       if (!whole_table) {
-        for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || grid.count(key) > 0; });
+        for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || is_flagged_cell(key); });
       } else {
         for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
           meets = meets || (in_table(i, j, k) && occupied[cell_of(i, j, k)]);
@@ -268,39 +289,59 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
       }
       return meets;
     };
-    std::vector<std::vector<int>> meeting(static_cast<std::size_t>(blocks));
-    tbb::parallel_for(0, blocks, [&](int b) {
-      for (int f = b * kBlock; f < std::min(nf, (b + 1) * kBlock); ++f) {
-        if (surface.status(FaceHandle(f)).deleted() || is_flagged(f)) continue;
-        Vec3 lo, hi;
-        bounds(corners(f), lo, hi);
-        if (meets_flagged(lo, hi)) meeting[std::size_t(b)].push_back(f);
-      }
+    const std::vector<int> meeting = collect<int>(nf, [&](int f, int& item) {
+      item = f;
+      if (surface.status(FaceHandle(f)).deleted() || is_flagged(f)) return false;
+      Vec3 lo, hi;
+      box_of(f, lo, hi);
+      return meets_flagged(lo, hi);
     });
-    for (const auto& block : meeting)
-      for (int f : block) {
-        add(f);
-        const Triangle& t = tris.back();
-        const int id = int(tris.size()) - 1;
-        for_cells(t.lo, t.hi, [&](std::uint64_t key) {
-          if (auto it = grid.find(key); it != grid.end()) it->second.push_back(id);
-        });
-      }
+    faces.insert(faces.end(), meeting.begin(), meeting.end());
+    // Their entries only in the cells that hold a flagged triangle: a pair of two others is not
+    // looked at.
+    std::vector<Entry> more = cell_entries(n_flagged, meeting.size(),
+                                           [&](std::size_t i, Vec3& lo, Vec3& hi) { box_of(faces[i], lo, hi); },
+                                           is_flagged_cell);
+    tbb::parallel_sort(more.begin(), more.end());
+    const std::size_t before = grid.size();
+    grid.insert(grid.end(), more.begin(), more.end());
+    std::inplace_merge(grid.begin(), grid.begin() + std::ptrdiff_t(before), grid.end());
   }
-  // The pairs of a cell, into `out`; false once `out` holds `limit`.
-  auto test_cell = [&](std::uint64_t key, const std::vector<int>& members, std::vector<std::pair<int, int>>& out) {
-    for (std::size_t m = 0; m < members.size(); ++m)
-      for (std::size_t n = m + 1; n < members.size(); ++n) {
-        if (!flagged[std::size_t(members[m])] && !flagged[std::size_t(members[n])]) continue;
-        const auto& a = tris[std::size_t(members[m])];
-        const auto& b = tris[std::size_t(members[n])];
+  std::vector<Triangle> tris(faces.size());
+  tbb::parallel_for(std::size_t(0), faces.size(), [&](std::size_t i) {
+    Triangle& t = tris[i];
+    const auto vs = face_vertices(surface, FaceHandle(faces[i]));
+    for (int k = 0; k < 3; ++k) t.v[k] = vs[k].idx(), t.p[k] = surface.point(vs[k]);
+    const Vec3 n = OpenMesh::cross(t.p[1] - t.p[0], t.p[2] - t.p[0]);
+    const double len = n.norm();
+    t.normal = len > 0 ? n / len : Vec3(0, 0, 0);
+    bounds(t.p, t.lo, t.hi);
+  });
+  const std::vector<int>& face_of = faces;
+  auto flagged = [&](int id) { return std::size_t(id) < n_flagged; };
+  // The cells: runs of one key in the sorted entries.
+  std::vector<std::size_t> cell_start;
+  for (std::size_t k = 0; k < grid.size(); ++k)
+    if (k == 0 || grid[k].first != grid[k - 1].first) cell_start.push_back(k);
+  cell_start.push_back(grid.size());
+  const std::size_t n_cells = cell_start.size() - 1;
+  // The pairs of cell c, into `out`; false once `out` holds `limit`. Each pair is tested once, in
+  // the cell holding the lower corner of their boxes' overlap.
+  auto test_cell = [&](std::size_t c, std::vector<std::pair<int, int>>& out) {
+    const std::uint64_t key = grid[cell_start[c]].first;
+    for (std::size_t m = cell_start[c]; m < cell_start[c + 1]; ++m)
+      for (std::size_t n = m + 1; n < cell_start[c + 1]; ++n) {
+        const int ia = grid[m].second, ib = grid[n].second;
+        if (!flagged(ia) && !flagged(ib)) continue;
+        const auto& a = tris[std::size_t(ia)];
+        const auto& b = tris[std::size_t(ib)];
         Vec3 lo = a.lo, hi = a.hi;
         lo.maximize(b.lo);
         hi.minimize(b.hi);
         if (lo[0] > hi[0] || lo[1] > hi[1] || lo[2] > hi[2]) continue;
         if (cell_key(index(lo[0], box.min[0]), index(lo[1], box.min[1]), index(lo[2], box.min[2])) != key) continue;
         if (pair_intersects(a, b, tol)) {
-          const int f = face_of[std::size_t(members[m])], g = face_of[std::size_t(members[n])];
+          const int f = face_of[std::size_t(ia)], g = face_of[std::size_t(ib)];
           out.emplace_back(std::min(f, g), std::max(f, g));
           if (out.size() >= limit) return false;
         }
@@ -308,16 +349,13 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     return true;
   };
   if (limit < std::numeric_limits<std::size_t>::max()) {  // stops at the limit: one cell after the other
-    for (const auto& [key, members] : grid)
-      if (!test_cell(key, members, found)) break;
+    for (std::size_t c = 0; c < n_cells; ++c)
+      if (!test_cell(c, found)) break;
   } else {  // every pair: the cells in parallel (the set found is the same in any order)
-    std::vector<const std::pair<const std::uint64_t, std::vector<int>>*> cells;
-    cells.reserve(grid.size());
-    for (const auto& entry : grid) cells.push_back(&entry);
     tbb::enumerable_thread_specific<std::vector<std::pair<int, int>>> local;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size(), 256), [&](const auto& range) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_cells, 256), [&](const auto& range) {
       auto& out = local.local();
-      for (std::size_t c = range.begin(); c < range.end(); ++c) test_cell(cells[c]->first, cells[c]->second, out);
+      for (std::size_t c = range.begin(); c < range.end(); ++c) test_cell(c, out);
     });
     for (const auto& part : local) found.insert(found.end(), part.begin(), part.end());
   }
