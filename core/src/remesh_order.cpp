@@ -44,32 +44,36 @@ std::vector<int> order_by_key(int count, int keys, Key&& key, std::vector<int>& 
   return order;
 }
 
+// Each element (of map.size(), times stride) to its new position map[i] (dropped when negative):
+// the old array is read in order, the new one written where the elements go.
 template <class T>
-bool gather_as(OpenMesh::BaseProperty& property, const std::vector<int>& order, int stride) {
+bool scatter_as(OpenMesh::BaseProperty& property, const std::vector<int>& map, std::size_t live, int stride) {
   auto* typed = dynamic_cast<OpenMesh::PropertyT<T>*>(&property);
   if (typed == nullptr) return false;
   auto& data = typed->data_vector();
-  std::vector<T> out(order.size() * std::size_t(stride));
-  tbb::parallel_for(0, int(order.size()), [&](int i) {
-    for (int s = 0; s < stride; ++s)
-      out[std::size_t(i) * std::size_t(stride) + std::size_t(s)] = data[std::size_t(order[std::size_t(i)]) * std::size_t(stride) + std::size_t(s)];
+  std::vector<T> out(live * std::size_t(stride));
+  tbb::parallel_for(0, int(map.size()), [&](int i) {
+    if (const int at = map[std::size_t(i)]; at >= 0)
+      for (int s = 0; s < stride; ++s)
+        out[std::size_t(at) * std::size_t(stride) + std::size_t(s)] = data[std::size_t(i) * std::size_t(stride) + std::size_t(s)];
   });
   data.swap(out);
   return true;
 }
 
 // Put element order[i] (times stride: halfedges follow their edge) at position i, for a property of
-// any type: the common types by a parallel gather (OpenMesh's per-element traits data, empty
+// any type: the common types by a parallel scatter (OpenMesh's per-element traits data, empty
 // structs here, among them), any other by swaps along the permutation's cycles (the deleted
 // elements go after the live ones and are cut off by the resize that follows).
 void permute(OpenMesh::BaseProperty& property, const std::vector<int>& order, const std::vector<int>& map, int stride) {
-  if (gather_as<Vec3>(property, order, stride) || gather_as<double>(property, order, stride) ||
-      gather_as<int>(property, order, stride) || gather_as<char>(property, order, stride) ||
-      gather_as<OpenMesh::Attributes::StatusInfo>(property, order, stride) ||
-      gather_as<SurfaceMesh::VertexData>(property, order, stride) ||
-      gather_as<SurfaceMesh::EdgeData>(property, order, stride) ||
-      gather_as<SurfaceMesh::HalfedgeData>(property, order, stride) ||
-      gather_as<SurfaceMesh::FaceData>(property, order, stride))
+  const std::size_t live = order.size();
+  if (scatter_as<Vec3>(property, map, live, stride) || scatter_as<double>(property, map, live, stride) ||
+      scatter_as<int>(property, map, live, stride) || scatter_as<char>(property, map, live, stride) ||
+      scatter_as<OpenMesh::Attributes::StatusInfo>(property, map, live, stride) ||
+      scatter_as<SurfaceMesh::VertexData>(property, map, live, stride) ||
+      scatter_as<SurfaceMesh::EdgeData>(property, map, live, stride) ||
+      scatter_as<SurfaceMesh::HalfedgeData>(property, map, live, stride) ||
+      scatter_as<SurfaceMesh::FaceData>(property, map, live, stride))
     return;
   const int n = int(map.size());
   std::vector<int> full(order);
@@ -293,12 +297,20 @@ void reorder_spatially(SurfaceMesh& mesh) {
   std::vector<int> v_half(static_cast<std::size_t>(live_v)), f_half(static_cast<std::size_t>(live_f));
   const std::size_t halfedges = 2 * static_cast<std::size_t>(live_e);
   std::vector<int> h_to(halfedges), h_next(halfedges), h_face(halfedges);
-  tbb::parallel_for(0, live_v, [&](int i) { v_half[std::size_t(i)] = hmap(mesh.halfedge_handle(VertexHandle(vorder[std::size_t(i)]))); });
-  tbb::parallel_for(0, live_f, [&](int i) { f_half[std::size_t(i)] = hmap(mesh.halfedge_handle(FaceHandle(forder[std::size_t(i)]))); });
-  tbb::parallel_for(0, live_e, [&](int i) {
+  // Each old element writes its new slot: the mesh's arrays are read in order, and only the maps
+  // (a few MB) are read at random.
+  tbb::parallel_for(0, nv, [&](int v) {
+    if (const int at = vmap[std::size_t(v)]; at >= 0) v_half[std::size_t(at)] = hmap(mesh.halfedge_handle(VertexHandle(v)));
+  });
+  tbb::parallel_for(0, nf, [&](int f) {
+    if (const int at = fmap[std::size_t(f)]; at >= 0) f_half[std::size_t(at)] = hmap(mesh.halfedge_handle(FaceHandle(f)));
+  });
+  tbb::parallel_for(0, ne, [&](int e) {
+    const int to_edge = emap[std::size_t(e)];
+    if (to_edge < 0) return;
     for (int k = 0; k < 2; ++k) {
-      HalfedgeHandle h(2 * eorder[std::size_t(i)] + k);
-      const std::size_t at = 2 * std::size_t(i) + std::size_t(k);
+      HalfedgeHandle h(2 * e + k);
+      const std::size_t at = 2 * std::size_t(to_edge) + std::size_t(k);
       h_to[at] = vmap[std::size_t(mesh.to_vertex_handle(h).idx())];
       h_next[at] = hmap(mesh.next_halfedge_handle(h));
       auto f = mesh.face_handle(h);
