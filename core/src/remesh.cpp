@@ -453,12 +453,15 @@ RemeshReport Remesher::run() {
   // evolution step appends and removes a few thousand elements, so it runs every few steps only,
   // and only when it would at least halve the disorder (on a surface much wider than high the
   // Z-order itself leaves ~11 %: renumbering at every step bought nothing).
-  if (opt_.spatial_order && report_.splits + report_.collapses + report_.flips > 0 &&
-      [&] {
-        const double disorder = spatial_disorder(m_);
-        return disorder > kReorderAbove && spatial_disorder_after_reorder(m_) < 0.5 * disorder;
-      }())
-    reorder_spatially(m_);
+  std::vector<int> order;  // the spatial order, sorted once for both the estimate and the renumbering
+  bool reorder = false;
+  if (opt_.spatial_order && report_.splits + report_.collapses + report_.flips > 0)
+    if (const double disorder = spatial_disorder(m_); disorder > kReorderAbove) {
+      order = spatial_vertex_order(m_);
+      reorder = spatial_disorder_after_reorder(m_, order) < 0.5 * disorder;
+    }
+  if (reorder)
+    reorder_spatially(m_, order);
   else if (report_.collapses > 0)
     collect_garbage(m_);
   stamp("compact");

@@ -130,17 +130,29 @@ double spatial_disorder(const SurfaceMesh& mesh) {
   return total_live > 0 ? double(total_far + 6 * holes) / double(total_live) : 0.0;
 }
 
-double spatial_disorder_after_reorder(const SurfaceMesh& mesh) {
-  std::vector<Vec3> points;
+std::vector<int> spatial_vertex_order(const SurfaceMesh& mesh) {
+  // The Z-order of the live vertices' positions in their bounding box (geometry.hpp), ties by index.
   std::vector<int> live;
+  std::vector<Vec3> points;
+  live.reserve(mesh.n_vertices());
+  points.reserve(mesh.n_vertices());
   for (auto v : mesh.vertices()) {
     live.push_back(v.idx());
     points.push_back(mesh.point(v));
   }
-  const std::vector<int> order = z_order(points);
+  std::vector<int> order = z_order(points);
+  for (int& i : order) i = live[std::size_t(i)];
+  return order;
+}
+
+double spatial_disorder_after_reorder(const SurfaceMesh& mesh) {
+  return spatial_disorder_after_reorder(mesh, spatial_vertex_order(mesh));
+}
+
+double spatial_disorder_after_reorder(const SurfaceMesh& mesh, const std::vector<int>& order) {
   std::vector<int> rank(mesh.n_vertices(), -1);
-  for (std::size_t i = 0; i < order.size(); ++i) rank[std::size_t(live[std::size_t(order[i])])] = int(i);
-  const double window = 16 * std::sqrt(double(live.size()));
+  for (std::size_t i = 0; i < order.size(); ++i) rank[std::size_t(order[i])] = int(i);
+  const double window = 16 * std::sqrt(double(order.size()));
   struct Count {
     std::size_t far = 0, live = 0;
   };
@@ -256,23 +268,12 @@ void collect_garbage(SurfaceMesh& mesh) {
   mesh.resize(std::size_t(live_v), std::size_t(live_e), std::size_t(live_f));
 }
 
-void reorder_spatially(SurfaceMesh& mesh) {
+void reorder_spatially(SurfaceMesh& mesh) { reorder_spatially(mesh, spatial_vertex_order(mesh)); }
+
+void reorder_spatially(SurfaceMesh& mesh, const std::vector<int>& vorder) {
   const int nv = int(mesh.n_vertices()), ne = int(mesh.n_edges()), nf = int(mesh.n_faces());
-  // Vertices: Z-order of their positions in the bounding box (geometry.hpp's z_order), ties by index.
-  std::vector<int> live;
-  std::vector<Vec3> points;
-  live.reserve(std::size_t(nv));
-  points.reserve(std::size_t(nv));
-  for (auto v : mesh.vertices()) {
-    live.push_back(v.idx());
-    points.push_back(mesh.point(v));
-  }
-  std::vector<int> vmap(static_cast<std::size_t>(nv), -1), vorder(live.size());
-  const std::vector<int> order = z_order(points);
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    vorder[i] = live[std::size_t(order[i])];
-    vmap[std::size_t(vorder[i])] = int(i);
-  }
+  std::vector<int> vmap(static_cast<std::size_t>(nv), -1);
+  for (std::size_t i = 0; i < vorder.size(); ++i) vmap[std::size_t(vorder[i])] = int(i);
   const int live_v = int(vorder.size());
 
   // Edges and faces: by their smallest new vertex index.

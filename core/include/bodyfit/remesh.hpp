@@ -13,6 +13,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 namespace bodyfit {
 
@@ -103,6 +104,11 @@ RemeshReport remesh(SurfaceMesh& mesh, const RemeshOptions& options = {});
 /// result for any number of threads; a mesh already in this order is left as it is. Costs one sort
 /// of the vertices, the rest is linear.
 void reorder_spatially(SurfaceMesh& mesh);
+/// The same with the vertex order given: spatial_vertex_order(mesh), found once for this and
+/// spatial_disorder_after_reorder (the sort is most of the cost of either).
+void reorder_spatially(SurfaceMesh& mesh, const std::vector<int>& order);
+/// The live vertices (indices) in the order reorder_spatially gives them.
+std::vector<int> spatial_vertex_order(const SurfaceMesh& mesh);
 
 /// How scattered `mesh` is in memory: the share of its edges whose ends' indices differ by more than
 /// 16 √(vertices) (a few rows of a well-ordered mesh, whatever the order: a generator's rows, a
@@ -113,6 +119,8 @@ double spatial_disorder(const SurfaceMesh& mesh);
 /// spatial_disorder once reorder_spatially had run, found without moving anything (the Z-order and
 /// one pass over the edges): ~1 % on a sphere, ~11 % on a surface much wider than high.
 double spatial_disorder_after_reorder(const SurfaceMesh& mesh);
+/// The same with the vertex order given (spatial_vertex_order(mesh)).
+double spatial_disorder_after_reorder(const SurfaceMesh& mesh, const std::vector<int>& order);
 
 /// Remove the deleted elements: the same arrays as OpenMesh's garbage_collection() (each hole, from
 /// the first, takes the last live element), but only the handles that point to a moved element are
