@@ -13,6 +13,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_reduce.h>
 
 namespace bodyfit {
 
@@ -166,49 +167,73 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
   std::vector<int> index(mesh.n_vertices(), -1);
   points_.reserve(mesh.n_vertices());
-  tri_.reserve(mesh.n_faces());
-  normal_.reserve(mesh.n_faces());
   for (auto v : mesh.vertices()) {
     index[v.idx()] = int(points_.size());
     points_.push_back(mesh.point(v));
   }
-  vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
+  // Reference triangle k is the k-th face that is not deleted.
+  std::vector<int> faces;
+  faces.reserve(mesh.n_faces());
   std::vector<int> face_index(mesh.n_faces(), -1);
   for (auto f : mesh.faces()) {
-    std::array<int, 3> t{};
-    int k = 0;
-    for (auto v : mesh.fv_range(f)) t[k++] = index[v.idx()];
-    face_index[std::size_t(f.idx())] = int(tri_.size());
-    tri_.push_back(t);
-    const Vec3 n = (points_[t[1]] - points_[t[0]]) % (points_[t[2]] - points_[t[0]]);
-    const double len = n.norm();
-    normal_.push_back(len > 0 ? n / len : Vec3(0, 0, 0));
-    for (int i : t) vertex_normal_[std::size_t(i)] += n;  // weighted by twice the area
+    face_index[std::size_t(f.idx())] = int(faces.size());
+    faces.push_back(f.idx());
+  }
+  const int nt = int(faces.size());
+  tri_.resize(std::size_t(nt));
+  normal_.resize(std::size_t(nt));
+  auto twice_area_normal = [&](const std::array<int, 3>& t) {
+    return (points_[std::size_t(t[1])] - points_[std::size_t(t[0])]) % (points_[std::size_t(t[2])] - points_[std::size_t(t[0])]);
+  };
+  tbb::parallel_for(tbb::blocked_range<int>(0, nt, 4096), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k < range.end(); ++k) {
+      std::array<int, 3>& t = tri_[std::size_t(k)];
+      int c = 0;
+      for (auto v : mesh.fv_range(FaceHandle(faces[std::size_t(k)]))) t[c++] = index[std::size_t(v.idx())];
+      const Vec3 n = twice_area_normal(t);
+      const double len = n.norm();
+      normal_[std::size_t(k)] = len > 0 ? n / len : Vec3(0, 0, 0);
+    }
+  });
+  // Vertex normals weighted by twice the area, summed in triangle order (the bits do not depend on
+  // the number of threads).
+  vertex_normal_.assign(points_.size(), Vec3(0, 0, 0));
+  for (const auto& t : tri_) {
+    const Vec3 n = twice_area_normal(t);
+    for (int i : t) vertex_normal_[std::size_t(i)] += n;
   }
   // The turn of the normal between two adjacent triangles per distance between their centroids: on
   // a fine tessellation of a sphere of radius R, 1/R; across a crease, the crease's angle over a
-  // triangle's size.
-  for (auto e : mesh.edges()) {
-    if (mesh.is_boundary(e)) continue;
-    const int f0 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(e, 0)).idx())];
-    const int f1 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(e, 1)).idx())];
+  // triangle's size. The largest over the edges, in parallel (a maximum in any order).
+  auto centroid = [&](int f) {
+    const auto& t = tri_[std::size_t(f)];
+    return (points_[std::size_t(t[0])] + points_[std::size_t(t[1])] + points_[std::size_t(t[2])]) / 3.0;
+  };
+  auto edge_curvature = [&](int e) {
+    const EdgeHandle edge(e);
+    if (mesh.status(edge).deleted() || mesh.is_boundary(edge)) return 0.0;
+    const int f0 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(edge, 0)).idx())];
+    const int f1 = face_index[std::size_t(mesh.face_handle(mesh.halfedge_handle(edge, 1)).idx())];
     const Vec3 &n0 = normal_[std::size_t(f0)], &n1 = normal_[std::size_t(f1)];
-    if (n0.sqrnorm() == 0 || n1.sqrnorm() == 0) {
-      max_curvature_ = std::numeric_limits<double>::infinity();
-      continue;
-    }
-    auto centroid = [&](int f) {
-      const auto& t = tri_[std::size_t(f)];
-      return (points_[std::size_t(t[0])] + points_[std::size_t(t[1])] + points_[std::size_t(t[2])]) / 3.0;
-    };
+    if (n0.sqrnorm() == 0 || n1.sqrnorm() == 0) return std::numeric_limits<double>::infinity();
     const double turn = std::atan2((n0 % n1).norm(), n0 | n1);
     const double apart = (centroid(f0) - centroid(f1)).norm();
-    max_curvature_ = std::max(max_curvature_, apart > 0 ? turn / apart : std::numeric_limits<double>::infinity());
-  }
-  for (Vec3& n : vertex_normal_) {
-    const double len = n.norm();
-    if (len > 0) n /= len;
-  }
+    return apart > 0 ? turn / apart : std::numeric_limits<double>::infinity();
+  };
+  max_curvature_ = tbb::parallel_reduce(
+      tbb::blocked_range<int>(0, int(mesh.n_edges()), 4096), 0.0,
+      [&](const tbb::blocked_range<int>& range, double most) {
+        for (int e = range.begin(); e < range.end(); ++e) most = std::max(most, edge_curvature(e));
+        return most;
+      },
+      [](double x, double y) { return std::max(x, y); });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertex_normal_.size(), 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      Vec3& n = vertex_normal_[i];
+      const double len = n.norm();
+      if (len > 0) n /= len;
+    }
+  });
 }
 
 ReferenceSurface::~ReferenceSurface() = default;
