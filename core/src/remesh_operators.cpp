@@ -203,6 +203,39 @@ bool Remesher::curve_collapse_within_hausd(HalfedgeHandle h) const {
   return true;
 }
 
+// OpenMesh's TriConnectivity::is_collapse_ok, the same tests in the same order, without its heap
+// allocations (several per call: most of a collapse check's cost) and without tagging vertices.
+bool Remesher::collapse_keeps_topology(HalfedgeHandle v0v1) const {
+  if (m_.status(m_.edge_handle(v0v1)).deleted()) return false;
+  const auto v1v0 = m_.opposite_halfedge_handle(v0v1);
+  const auto v0 = m_.to_vertex_handle(v1v0), v1 = m_.to_vertex_handle(v0v1);
+  if (m_.status(v0).deleted() || m_.status(v1).deleted()) return false;
+  // Neither triangle on the edge may have its two other sides on the boundary.
+  VertexHandle vl, vr;
+  if (!m_.is_boundary(v0v1)) {
+    const auto h1 = m_.next_halfedge_handle(v0v1), h2 = m_.next_halfedge_handle(h1);
+    vl = m_.to_vertex_handle(h1);
+    if (m_.is_boundary(m_.opposite_halfedge_handle(h1)) && m_.is_boundary(m_.opposite_halfedge_handle(h2))) return false;
+  }
+  if (!m_.is_boundary(v1v0)) {
+    const auto h1 = m_.next_halfedge_handle(v1v0), h2 = m_.next_halfedge_handle(h1);
+    vr = m_.to_vertex_handle(h1);
+    if (m_.is_boundary(m_.opposite_halfedge_handle(h1)) && m_.is_boundary(m_.opposite_halfedge_handle(h2))) return false;
+  }
+  if (vl == vr) return false;
+  // The one-rings of v0 and v1 meet only at vl and vr.
+  VertexHandle ring[kMaxValence];
+  int n = 0;
+  for (auto w : m_.vv_range(v1)) {
+    if (n == kMaxValence) return const_cast<SurfaceMesh&>(m_).is_collapse_ok(v0v1);  // a valence no remesh makes
+    ring[n++] = w;
+  }
+  for (auto w : m_.vv_range(v0))
+    if (w != vl && w != vr && std::find(ring, ring + n, w) != ring + n) return false;
+  // An edge between two boundary vertices must be a boundary edge.
+  return !(m_.is_boundary(v0) && m_.is_boundary(v1) && !m_.is_boundary(v0v1) && !m_.is_boundary(v1v0));
+}
+
 // Whether collapsing h (its from-vertex v0 onto its to-vertex v1) keeps features, topology and
 // geometry (no fold, no edge made too long) and is worth it by `rule`; `change` receives the
 // qualities of v0's star.
@@ -222,7 +255,7 @@ bool Remesher::collapse_check(HalfedgeHandle h, Change& change, Rule rule) const
     auto e0 = m_.edge_handle(n1), e1 = m_.edge_handle(m_.next_halfedge_handle(n1));
     if (m_.property(ecurve_, e0) != kNoCurve && m_.property(ecurve_, e1) != kNoCurve) return false;
   }
-  if (!const_cast<SurfaceMesh&>(m_).is_collapse_ok(h)) return false;
+  if (!collapse_keeps_topology(h)) return false;
   if ((kind == kCurveVertex || kind == kCornerVertex) && !curve_collapse_within_hausd(h)) return false;
   const Vec3& p1 = m_.point(v1);
   double old_min = 1, new_min = 1;
@@ -464,13 +497,12 @@ bool Remesher::move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Cha
   change = Change{};
   // The star of v, one spoke per outgoing halfedge h: its face (if any) is (v, w1, w2), w1 = to(h),
   // w2 = to(next(h)); the face across (w2, w1) is unchanged by the move.
-  constexpr int kMaxStar = 64;
-  Vec3 moved_normal[kMaxStar];
-  HalfedgeHandle spoke[kMaxStar];
+  Vec3 moved_normal[kMaxValence];
+  HalfedgeHandle spoke[kMaxValence];
   int n = 0;
   const Vec3& p = m_.point(v);
   for (auto h : m_.voh_range(v)) {
-    if (n == kMaxStar) return false;  // no such valence in a mesh worth relocating in
+    if (n == kMaxValence) return false;  // no such valence in a mesh worth relocating in
     spoke[n] = h;
     Vec3& moved = moved_normal[n++];
     moved = Vec3(0, 0, 0);

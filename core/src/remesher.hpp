@@ -79,6 +79,9 @@ inline constexpr double kProgress = 0.75;
 inline constexpr double kReorderAbove = 0.1;
 // A relocation moving a vertex by more than this fraction of its size re-queues its ring.
 inline constexpr double kMoveSpread = 0.05;
+// The largest star the checks hold on the stack; a larger one (no remesh makes it) is refused or
+// checked the slow way.
+inline constexpr int kMaxValence = 64;
 // A triangle whose doubled area is at most this fraction of its summed squared edge lengths is
 // degenerate: its cross product is rounding noise, so its "normal" may point anywhere (and pass any
 // orientation test by chance). It gets no normal and quality 0, which every check refuses.
@@ -231,6 +234,7 @@ class Remesher {
   // `projected`: the edge's midpoint already projected onto S (ref_->closest from its first end's hint).
   bool split(EdgeHandle e, const SurfacePoint* projected = nullptr);
   bool collapse(EdgeHandle e);
+  bool collapse_keeps_topology(HalfedgeHandle v0v1) const;
   bool collapse_check(HalfedgeHandle h, Change& change, Rule rule) const;
   bool curve_collapse_within_hausd(HalfedgeHandle h) const;
   void collapse_halfedge(HalfedgeHandle h);
