@@ -290,7 +290,11 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
                                           flat + 1, area(flat), options.min_relative_area));
 
   SurfaceMesh mesh;
-  mesh.reserve(r.points.size(), r.points.size() + r.triangles.size(), r.triangles.size());
+  // Room for an eighth more of each (never touched, so no memory until used): the cut and remesh
+  // that usually follow a read add a few per cent, and each growth beyond the arrays' size would
+  // copy every one of them.
+  auto with_room = [](std::size_t n) { return n + n / 8; };
+  mesh.reserve(with_room(r.points.size()), with_room(r.points.size() + r.triangles.size()), with_room(r.triangles.size()));
   // The vertices at once (add_vertex grows every vertex property by one, vertex after vertex).
   mesh.resize(r.points.size(), 0, 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, r.points.size(), 4096), [&](const auto& range) {
