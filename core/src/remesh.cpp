@@ -226,7 +226,8 @@ void Remesher::split_long_edges() {
       for (auto h : m_.voh_range(v)) edges_.push_back(m_.edge_handle(h));
     flip_in_order(edges_);
   }
-  // The first round's projections fill tens of MB the passes would otherwise grow the heap beside.
+  // The split rounds' projections (tens of MB for a large refinement) are not read by the passes:
+  // freed here, their memory serves the passes instead of the heap growing beside it.
   release_buffers(projected_);
 }
 
