@@ -28,7 +28,9 @@ struct BoxTree {
   };
   std::vector<Node> nodes;
   std::vector<int> order;  ///< primitive indices, leaves hold contiguous ranges
-  void build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi);
+  /// Over primitives 0..n−1, `box(i, lo, hi)` giving primitive i's bounding box.
+  template <class Box>
+  void build(int n, const Box& box);
 };
 
 namespace {
@@ -40,45 +42,66 @@ int subtree_nodes(int n) { return n <= kLeafSize ? 1 : 1 + subtree_nodes(n / 2) 
 
 /// Median splits along the longest axis of the box centres: tight boxes, so queries visit few
 /// nodes (median splits of the Z-order built 3× faster but made the remesher's queries 3× slower).
-/// The two halves are built in parallel.
+/// The primitives' centres travel with their indices, so the splits read and swap contiguous
+/// memory; the node boxes are the union of the children's, made on the way back up. The two
+/// halves are built in parallel.
+template <class Box>
 struct Builder {
-  const std::vector<Vec3>& lo;
-  const std::vector<Vec3>& hi;
-  const std::vector<Vec3>& centre2;  ///< lo + hi (twice the box centres)
+  struct Item {
+    Vec3 centre2;  ///< lo + hi (twice the box centre)
+    int primitive;
+  };
+  const Box& box;
+  std::vector<Item> items;
   BoxTree& tree;
 
-  /// Build the subtree over order[begin, end) into nodes[id, id + subtree_nodes(end − begin)).
+  /// Build the subtree over items[begin, end) into nodes[id, id + subtree_nodes(end − begin)).
   void build(int id, int begin, int end) {
-    BoxTree::Node& node = tree.nodes[id];
-    Vec3 nlo(std::numeric_limits<double>::max()), nhi(-std::numeric_limits<double>::max());
-    Vec3 clo = nlo, chi = nhi;  // bounds of the box centres
-    for (int i = begin; i < end; ++i) {
-      const int p = tree.order[i];
-      nlo.minimize(lo[p]);
-      nhi.maximize(hi[p]);
-      clo.minimize(centre2[p]);
-      chi.maximize(centre2[p]);
-    }
-    node.lo = nlo;
-    node.hi = nhi;
+    BoxTree::Node& node = tree.nodes[std::size_t(id)];
     if (end - begin <= kLeafSize) {
+      Vec3 nlo(std::numeric_limits<double>::max()), nhi(-std::numeric_limits<double>::max());
+      for (int i = begin; i < end; ++i) {
+        const int p = items[std::size_t(i)].primitive;
+        tree.order[std::size_t(i)] = p;
+        Vec3 lo, hi;
+        box(p, lo, hi);
+        nlo.minimize(lo);
+        nhi.maximize(hi);
+      }
+      node.lo = nlo;
+      node.hi = nhi;
       node.begin = begin;
       node.end = end;
       return;
     }
+    Vec3 clo(std::numeric_limits<double>::max()), chi(-std::numeric_limits<double>::max());  // of the centres
+    for (int i = begin; i < end; ++i) {
+      clo.minimize(items[std::size_t(i)].centre2);
+      chi.maximize(items[std::size_t(i)].centre2);
+    }
     const Vec3 ext = chi - clo;
     const int axis = ext[0] > ext[1] ? (ext[0] > ext[2] ? 0 : 2) : (ext[1] > ext[2] ? 1 : 2);
     const int mid = (begin + end) / 2;
-    std::nth_element(tree.order.begin() + begin, tree.order.begin() + mid, tree.order.begin() + end,
-                     [&](int a, int b) { return centre2[a][axis] < centre2[b][axis]; });
+    auto split = [&]<int k>(std::integral_constant<int, k>) {  // the axis known to the compiler
+      std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                       [](const Item& a, const Item& b) { return a.centre2[k] < b.centre2[k]; });
+    };
+    if (axis == 0) split(std::integral_constant<int, 0>());
+    else if (axis == 1) split(std::integral_constant<int, 1>());
+    else split(std::integral_constant<int, 2>());
     node.left = id + 1;
     node.right = id + 1 + subtree_nodes(mid - begin);
-    if (end - begin > 16384)  // the halves write disjoint ranges of `order` and `nodes`
+    if (end - begin > 16384)  // the halves write disjoint ranges of `items`, `order` and `nodes`
       tbb::parallel_invoke([&] { build(node.left, begin, mid); }, [&] { build(node.right, mid, end); });
     else {
       build(node.left, begin, mid);
       build(node.right, mid, end);
     }
+    const BoxTree::Node &left = tree.nodes[std::size_t(node.left)], &right = tree.nodes[std::size_t(node.right)];
+    node.lo = left.lo;
+    node.lo.minimize(right.lo);
+    node.hi = left.hi;
+    node.hi.maximize(right.hi);
   }
 };
 
@@ -119,16 +142,24 @@ void nearest(const BoxTree& tree, const Vec3& p, double& best2, Distance&& dista
 }
 }  // namespace
 
-void BoxTree::build(const std::vector<Vec3>& lo, const std::vector<Vec3>& hi) {
+template <class Box>
+void BoxTree::build(int n, const Box& box) {
   nodes.clear();
   order.clear();
-  if (lo.empty()) return;
-  std::vector<Vec3> centre2(lo.size());
-  for (std::size_t i = 0; i < lo.size(); ++i) centre2[i] = lo[i] + hi[i];
-  order.resize(lo.size());
-  std::iota(order.begin(), order.end(), 0);
-  nodes.resize(std::size_t(subtree_nodes(int(lo.size()))));
-  Builder{lo, hi, centre2, *this}.build(0, 0, int(lo.size()));
+  if (n <= 0) return;
+  // The boxes are made again at the leaves rather than kept: two arrays of the primitives' size
+  // less at the remesh's memory peak.
+  Builder<Box> builder{box, std::vector<typename Builder<Box>::Item>(std::size_t(n)), *this};
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096), [&](const tbb::blocked_range<int>& range) {
+    for (int i = range.begin(); i < range.end(); ++i) {
+      Vec3 lo, hi;
+      box(i, lo, hi);
+      builder.items[std::size_t(i)] = {lo + hi, i};
+    }
+  });
+  order.resize(std::size_t(n));
+  nodes.resize(std::size_t(subtree_nodes(n)));
+  builder.build(0, 0, n);
 }
 
 }  // namespace detail
@@ -248,18 +279,16 @@ std::shared_ptr<ReferenceSurface> ReferenceSurface::sphere(const Vec3& center, d
 
 void ReferenceSurface::ensure_tree() const {
   std::call_once(tree_once_, [this] {
-    std::vector<Vec3> lo(tri_.size()), hi(tri_.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tri_.size(), 4096), [&](const auto& range) {
-      for (std::size_t i = range.begin(); i < range.end(); ++i) {
-        lo[i] = hi[i] = points_[tri_[i][0]];
-        for (int k = 1; k < 3; ++k) {
-          lo[i].minimize(points_[tri_[i][k]]);
-          hi[i].maximize(points_[tri_[i][k]]);
-        }
-      }
-    });
     tree_ = std::make_unique<detail::BoxTree>();
-    tree_->build(lo, hi);
+    auto box = [this](int i, Vec3& lo, Vec3& hi) {
+      const auto& t = tri_[std::size_t(i)];
+      lo = hi = points_[std::size_t(t[0])];
+      for (int k = 1; k < 3; ++k) {
+        lo.minimize(points_[std::size_t(t[std::size_t(k)])]);
+        hi.maximize(points_[std::size_t(t[std::size_t(k)])]);
+      }
+    };
+    tree_->build(int(tri_.size()), box);
   });
 }
 
@@ -408,20 +437,19 @@ Vec3 ReferencePolyline::closest_on(std::size_t i, const Vec3& p) const {
 
 void ReferencePolyline::ensure_tree() const {
   if (built_) return;
-  std::vector<Vec3> lo(a_.size()), hi(a_.size());
-  for (std::size_t i = 0; i < a_.size(); ++i) {
-    lo[i] = a_[i];
-    lo[i].minimize(b_[i]);
-    hi[i] = a_[i];
-    hi[i].maximize(b_[i]);
-    if (smooth_[i])  // the arc lies in the hull of its Bézier control points
-      for (const Vec3& q : {a_[i] + da_[i] / 3.0, b_[i] - db_[i] / 3.0}) {
-        lo[i].minimize(q);
-        hi[i].maximize(q);
+  auto box = [this](int i, Vec3& lo, Vec3& hi) {
+    const auto k = std::size_t(i);
+    lo = hi = a_[k];
+    lo.minimize(b_[k]);
+    hi.maximize(b_[k]);
+    if (smooth_[k])  // the arc lies in the hull of its Bézier control points
+      for (const Vec3& q : {a_[k] + da_[k] / 3.0, b_[k] - db_[k] / 3.0}) {
+        lo.minimize(q);
+        hi.maximize(q);
       }
-  }
+  };
   if (!tree_) tree_ = std::make_unique<detail::BoxTree>();
-  tree_->build(lo, hi);
+  tree_->build(int(a_.size()), box);
   built_ = true;
 }
 
