@@ -180,12 +180,10 @@ void Remesher::repair_self_intersections() {
   // evolution step's whole remesh (175 ms on a 240k-face height field against 50).
   std::vector<int> changed;
   auto near_changes = [&] {
-    changed.clear();
+    changed.clear();  // a face may come several times: self_intersections_near takes it once
     for (auto v : touched_list_)
       if (!m_.status(v).deleted())
         for (auto f : m_.vf_range(v)) changed.push_back(f.idx());
-    std::sort(changed.begin(), changed.end());
-    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
     return self_intersections_near(m_, changed);
   };
   std::vector<std::pair<int, int>> pairs = near_changes();

@@ -265,18 +265,25 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     auto cell_of = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
       return std::size_t((i + 1) + nx * ((j + 1) + ny * (k + 1)));
     };
+    // The table is made from the flagged cells' keys, which name their cells unambiguously while
+    // every index is within 21 bits (cell_key); a flagged cell outside it (not expected: every
+    // triangle is in the box) leaves the keys.
+    constexpr std::int64_t kKeyRange = (1 << 20) - 2;
+    auto decode = [](std::uint64_t key, int shift) { return std::int64_t((key >> shift) & 0x1FFFFF) - (1 << 20); };
+    auto key_in_table = [&](std::uint64_t key) { return in_table(decode(key, 42), decode(key, 21), decode(key, 0)); };
+    const bool whole_table = nx > 0 && ny > 0 && nz > 0 && nx < kKeyRange && ny < kKeyRange && nz < kKeyRange &&
+                             nx * ny * nz <= (std::int64_t(1) << 26) &&
+                             std::all_of(flagged_cells.begin(), flagged_cells.end(), key_in_table);
     std::vector<char> occupied;
-    bool whole_table = nx > 0 && ny > 0 && nz > 0 && nx * ny * nz <= (std::int64_t(1) << 26);
+    auto occupied_at = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+      return in_table(i, j, k) && occupied[cell_of(i, j, k)];
+    };
     if (whole_table) {
       occupied.assign(std::size_t(nx * ny * nz), 0);
-      for (std::size_t i = 0; i < n_flagged && whole_table; ++i) {
-        Vec3 lo, hi;
-        box_of(faces[i], lo, hi);
-        for_cell_indices(lo, hi, [&](std::int64_t x, std::int64_t y, std::int64_t z) {
-          if (in_table(x, y, z)) occupied[cell_of(x, y, z)] = 1;
-          else whole_table = false;  // not expected (every triangle is in the box): the keys then
-        });
-      }
+      tbb::parallel_for(std::size_t(0), flagged_cells.size(), [&](std::size_t c) {
+        const std::uint64_t key = flagged_cells[c];
+        occupied[cell_of(decode(key, 42), decode(key, 21), decode(key, 0))] = 1;
+      });
     }
     auto meets_flagged = [&](const Vec3& lo, const Vec3& hi) {
       bool meets = false;
@@ -284,7 +291,7 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
         for_cells(lo, hi, [&](std::uint64_t key) { meets = meets || is_flagged_cell(key); });
       } else {
         for_cell_indices(lo, hi, [&](std::int64_t i, std::int64_t j, std::int64_t k) {
-          meets = meets || (in_table(i, j, k) && occupied[cell_of(i, j, k)]);
+          meets = meets || occupied_at(i, j, k);
         });
       }
       return meets;
@@ -301,7 +308,10 @@ std::vector<std::pair<int, int>> find_crossings(const SurfaceMesh& surface, cons
     // looked at.
     std::vector<Entry> more = cell_entries(n_flagged, meeting.size(),
                                            [&](std::size_t i, Vec3& lo, Vec3& hi) { box_of(faces[i], lo, hi); },
-                                           is_flagged_cell);
+                                           [&](std::uint64_t key) {
+                                             return whole_table ? occupied_at(decode(key, 42), decode(key, 21), decode(key, 0))
+                                                                : is_flagged_cell(key);
+                                           });
     tbb::parallel_sort(more.begin(), more.end());
     const std::size_t before = grid.size();
     grid.insert(grid.end(), more.begin(), more.end());

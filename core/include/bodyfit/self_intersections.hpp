@@ -18,8 +18,9 @@ namespace bodyfit {
 std::vector<std::pair<int, int>> self_intersections(const SurfaceMesh& surface,
                                                     std::size_t limit = std::numeric_limits<std::size_t>::max());
 
-/// The same, among the pairs with at least one of `faces` (face indices): the crossings near a
-/// change, at the cost of those faces' neighbourhoods rather than the whole surface's grid.
+/// The same, among the pairs with at least one of `faces` (face indices, in any order, repeats
+/// allowed): the crossings near a change, at the cost of those faces' neighbourhoods rather than
+/// the whole surface's grid.
 std::vector<std::pair<int, int>> self_intersections_near(const SurfaceMesh& surface, std::span<const int> faces,
                                                          std::size_t limit = std::numeric_limits<std::size_t>::max());
 
