@@ -85,6 +85,21 @@ void check_nearest(const SurfaceMesh& mesh, int samples) {
         CHECK(std::abs(to_hint - (closest_point_on_triangle(p, ha, hb, hc) - p).norm()) <= 1e-13 * size);
         CHECK(found <= to_hint * (1 + 1e-12) + 1e-15 * size);
       }
+      // ... and to the triangles across the hint's sides, found here by the mesh's own adjacency
+      // (none on a boundary side): the next bounds the remesher tries.
+      double across = std::numeric_limits<double>::infinity();
+      if (hint >= 0)
+        for (auto g : mesh.ff_range(FaceHandle(hint))) {
+          auto [ga, gb, gc] = face_points(mesh, g);
+          across = std::min(across, (closest_point_on_triangle(p, ga, gb, gc) - p).norm());
+        }
+      const double to_neighbours = surface.distance_to_neighbours(p, hint);
+      if (std::isinf(across)) {
+        CHECK(std::isinf(to_neighbours));
+      } else {
+        CHECK(std::abs(to_neighbours - across) <= 1e-13 * size);
+        CHECK(found <= to_neighbours * (1 + 1e-12) + 1e-15 * size);
+      }
       ++checked;
     }
   }
@@ -97,6 +112,7 @@ TEST_CASE("ReferenceSurface::closest is the nearest of all the triangles: a sphe
   SUBCASE("a geodesic sphere") { check_nearest(make_sphere({.faces = 20000}), 600); }
   SUBCASE("the exact sphere has no triangles to bound by") {
     CHECK(std::isinf(ReferenceSurface::sphere(Vec3(0, 0, 0), 1)->distance_to_triangle(Vec3(0, 0, 2), 0)));
+    CHECK(std::isinf(ReferenceSurface::sphere(Vec3(0, 0, 0), 1)->distance_to_neighbours(Vec3(0, 0, 2), 0)));
   }
   SUBCASE("public meshes: creases, boundaries, handles, very uneven triangles") {
     for (const char* name : {"fandisk", "anchor", "knot1", "elephant-with-holes"}) {

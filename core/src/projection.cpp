@@ -221,6 +221,7 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
       std::array<int, 3>& t = tri_[std::size_t(k)];
       int c = 0;
       for (auto v : mesh.fv_range(FaceHandle(faces[std::size_t(k)]))) t[c++] = index[std::size_t(v.idx())];
+
       const Vec3 n = twice_area_normal(t);
       const double len = n.norm();
       normal_[std::size_t(k)] = len > 0 ? n / len : Vec3(0, 0, 0);
@@ -330,6 +331,44 @@ double ReferenceSurface::distance_to_triangle(const Vec3& p, int i) const {
   if (is_sphere_ || i < 0 || i >= int(tri_.size())) return std::numeric_limits<double>::infinity();
   const auto& t = tri_[std::size_t(i)];
   return (closest_point_on_triangle(p, points_[t[0]], points_[t[1]], points_[t[2]]) - p).norm();
+}
+
+void ReferenceSurface::ensure_neighbours() const {
+  std::call_once(neighbours_once_, [this] {
+    // Each vertex's triangles (a counting sort), then across each side a triangle that has it the
+    // other way round (on a manifold surface the only one).
+    const std::size_t nv = points_.size(), nt = tri_.size();
+    std::vector<int> first(nv + 1, 0), around(3 * nt);
+    for (const auto& t : tri_)
+      for (int v : t) ++first[std::size_t(v) + 1];
+    for (std::size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+    std::vector<int> next(first.begin(), first.end() - 1);
+    for (std::size_t k = 0; k < nt; ++k)
+      for (int v : tri_[k]) around[std::size_t(next[std::size_t(v)]++)] = int(k);
+    neighbour_.resize(nt);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 4096), [&](const auto& range) {
+      for (std::size_t k = range.begin(); k < range.end(); ++k)
+        for (int i = 0; i < 3; ++i) {
+          const int a = tri_[k][std::size_t(i)], b = tri_[k][std::size_t((i + 1) % 3)];
+          int& across = neighbour_[k][std::size_t(i)];
+          across = -1;
+          for (int at = first[std::size_t(b)]; at < first[std::size_t(b) + 1] && across < 0; ++at) {
+            const auto& u = tri_[std::size_t(around[std::size_t(at)])];
+            for (int j = 0; j < 3; ++j)
+              if (u[std::size_t(j)] == b && u[std::size_t((j + 1) % 3)] == a) across = around[std::size_t(at)];
+          }
+        }
+    });
+  });
+}
+
+double ReferenceSurface::distance_to_neighbours(const Vec3& p, int i) const {
+  double least = std::numeric_limits<double>::infinity();
+  if (is_sphere_ || i < 0 || i >= int(tri_.size())) return least;
+  ensure_neighbours();
+  for (int j : neighbour_[std::size_t(i)])
+    if (j >= 0) least = std::min(least, distance_to_triangle(p, j));
+  return least;
 }
 
 Vec3 ReferenceSurface::smooth_normal(const SurfacePoint& q) const {

