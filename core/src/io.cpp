@@ -273,17 +273,30 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
                                               i + 1, nv));
     throw r.triangle_at.error(file, t, fmt::format("triangle {} uses the same vertex twice", t + 1));
   }
-  auto side = [&](int k) {  // side k % 3 of triangle k / 3
-    const auto& tri = r.triangles[std::size_t(k / 3)];
-    return (r.points[std::size_t(tri[(k + 1) % 3])] - r.points[std::size_t(tri[k % 3])]).norm();
-  };
-  const double mean_length = sum_in_order(3 * nt, side) / (3.0 * double(nt));
-  const double min_area = options.min_relative_area * mean_length * mean_length;
   auto area = [&](int t) {
     const auto& tri = r.triangles[std::size_t(t)];
     return 0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
   };
-  const int flat = first_where(nt, [&](int t) { return !(area(t) > min_area); });
+  // The sides' total length (by fixed blocks: the same for any number of threads) and the least
+  // area in one sweep; the first triangle too small is looked for only when the least one is.
+  struct Scale {
+    double length = 0, least_area = std::numeric_limits<double>::infinity();
+  };
+  const Scale scale = reduce(
+      nt, Scale{},
+      [&](int t, Scale& s) {
+        const auto& tri = r.triangles[std::size_t(t)];
+        const Vec3 &a = r.points[std::size_t(tri[0])], &b = r.points[std::size_t(tri[1])], &c = r.points[std::size_t(tri[2])];
+        s.length += (b - a).norm() + (c - b).norm() + (a - c).norm();
+        if (const double a = area(t); !(a >= s.least_area)) s.least_area = a;  // a NaN too
+      },
+      [](Scale& total, const Scale& s) {
+        total.length += s.length;
+        if (!(s.least_area >= total.least_area)) total.least_area = s.least_area;
+      });
+  const double mean_length = scale.length / (3.0 * double(nt));
+  const double min_area = options.min_relative_area * mean_length * mean_length;
+  const int flat = scale.least_area > min_area ? nt : first_where(nt, [&](int t) { return !(area(t) > min_area); });
   if (flat < nt)
     throw r.triangle_at.error(file, std::size_t(flat),
                               fmt::format("triangle {} has zero area ({:.3g}, below {:.3g} x mean edge length^2)",
