@@ -7,8 +7,8 @@
 // files, besides `read` (parse + validated build of the mesh, in this warm process) and `write`:
 //   parse   the parse alone (the records, before the mesh is built);
 //   cold    a read in a fresh process, as `bodyfit <command> in.mesh` does it: restarted once
-//           with its heap on transparent huge pages as the commands are, memory never touched
-//           before (page faults included).
+//           with its heap on transparent huge pages and freed blocks kept, as the commands are,
+//           memory never touched before (page faults included).
 #include "bench_args.hpp"
 
 #include <bodyfit/app/huge_page_heap.hpp>
@@ -117,7 +117,8 @@ double cold_read(const fs::path& file) {
 int main(int argc, char** argv) {
   const Arguments args = parse_arguments(argc, argv);
   if (!args.read_once.empty()) {
-    restart_on_huge_pages(argv);  // as the stage commands do
+    restart_on_huge_pages(argv);  // the heap as the stage commands have it
+    keep_freed_blocks();
     const double s = seconds_of([&] { (void)read_mesh(args.read_once); });
     std::printf("%.9f\n", s);
     return 0;

@@ -1,5 +1,7 @@
 #include <bodyfit/app/huge_page_heap.hpp>
 
+#include <malloc.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -26,6 +28,11 @@ void restart_on_huge_pages(char** argv) {
 bool heap_on_huge_pages() {
   const char* tunables = std::getenv("GLIBC_TUNABLES");
   return tunables && std::string(tunables).find("glibc.malloc.hugetlb=1") != std::string::npos;
+}
+
+void keep_freed_blocks() {
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
 }  // namespace bodyfit

@@ -15,7 +15,6 @@
 #include <csignal>
 #include <new>
 
-#include <malloc.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <tbb/global_control.h>
@@ -46,12 +45,7 @@ CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
 
 int main(int argc, char** argv) {
   using namespace bodyfit;
-  // Keep freed blocks up to 256 MiB in the heap instead of unmapping them: every stage allocates
-  // arrays of 10-130 MB at a million faces, and glibc's default maps and unmaps each one, so every
-  // reuse pays a page fault per 4 KiB (a third of the CPU time was system time). Peak memory grows
-  // by about a fifth (docs/validation/performance.md).
-  mallopt(M_MMAP_THRESHOLD, 256 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  keep_freed_blocks();
   // A file-size limit (ulimit -f) makes a write fail with EFBIG, an I/O error that removes its
   // temporary, instead of SIGXFSZ killing the process with the temporary left behind.
   std::signal(SIGXFSZ, SIG_IGN);

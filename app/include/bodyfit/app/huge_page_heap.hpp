@@ -1,5 +1,5 @@
 #pragma once
-// One-shot processes on transparent huge pages.
+// The heap of bodyfit's processes: one-shot processes on transparent huge pages, freed blocks kept.
 //
 // A process's fresh memory costs a page fault per 4 KiB page at its first write. On the virtual
 // machines bodyfit is measured on a fault costs ~14 µs, so a stage command (read a mesh, one stage,
@@ -19,5 +19,11 @@ void restart_on_huge_pages(char** argv);
 
 /// Whether this process started with glibc.malloc.hugetlb=1.
 bool heap_on_huge_pages();
+
+/// Keeps freed blocks up to 256 MiB in the heap instead of unmapping them, as `bodyfit` does from
+/// its start: every stage allocates arrays of 10-130 MB at a million faces, and glibc's default
+/// maps and unmaps each one, so every reuse pays its page faults again (a third of the CPU time was
+/// system time). Peak memory grows by about a fifth (docs/validation/performance.md).
+void keep_freed_blocks();
 
 }  // namespace bodyfit
