@@ -1,0 +1,140 @@
+// Whether a surface is a height field over a plane (height_field.hpp).
+#include <bodyfit/height_field.hpp>
+
+#include <bodyfit/geometry.hpp>
+
+#include "blocks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace bodyfit {
+namespace {
+
+constexpr double kFacing = 0.1;        // cos 84°: a face steeper than that is not trusted to face d
+constexpr double kTouching = 1e-9;     // of the shadow's size: closer than that counts as touching
+
+struct Point2 {
+  double x, y;
+};
+
+double cross2(Point2 o, Point2 a, Point2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
+
+double distance_to_segment(Point2 p, Point2 a, Point2 b) {
+  const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
+  const double t = l2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
+  return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
+}
+
+/// Whether the segments ab and cd cross or come within `tol` of each other.
+bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double tol) {
+  const double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  return distance_to_segment(c, a, b) <= tol || distance_to_segment(d, a, b) <= tol ||
+         distance_to_segment(a, c, d) <= tol || distance_to_segment(b, c, d) <= tol;
+}
+
+/// Whether the closed polygon is simple: no two sides meet but neighbours at their common corner
+/// (and those do not fold back onto each other). Sides are paired through a grid of cells about a
+/// side long.
+bool is_simple_polygon(const std::vector<Point2>& corners) {
+  const std::size_t n = corners.size();
+  if (n < 3) return false;
+  Point2 lo = corners[0], hi = corners[0];
+  double perimeter = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point2 p = corners[i], q = corners[(i + 1) % n];
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    perimeter += std::hypot(q.x - p.x, q.y - p.y);
+  }
+  const double tol = kTouching * std::hypot(hi.x - lo.x, hi.y - lo.y);
+  if (!(tol > 0)) return false;
+  auto side = [&](std::size_t i) { return std::pair{corners[i], corners[(i + 1) % n]}; };
+  for (std::size_t i = 0; i < n; ++i) {  // neighbours: only their common corner
+    const auto [a, b] = side(i);
+    const Point2 c = corners[(i + 2) % n];
+    if (distance_to_segment(c, a, b) <= tol || distance_to_segment(a, b, c) <= tol) return false;
+  }
+  const double cell = std::max(perimeter / double(n), tol);
+  auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;  // (cell, side), sorted by cell
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [a, b] = side(i);
+    for (auto x = index(std::min(a.x, b.x) - tol, lo.x); x <= index(std::max(a.x, b.x) + tol, lo.x); ++x)
+      for (auto y = index(std::min(a.y, b.y) - tol, lo.y); y <= index(std::max(a.y, b.y) + tol, lo.y); ++y)
+        entries.emplace_back((std::uint64_t(x + 1) << 32) | std::uint64_t(y + 1), std::uint32_t(i));
+  }
+  std::sort(entries.begin(), entries.end());
+  for (std::size_t first = 0; first < entries.size();) {
+    std::size_t last = first;
+    while (last < entries.size() && entries[last].first == entries[first].first) ++last;
+    for (std::size_t m = first; m < last; ++m)
+      for (std::size_t k = m + 1; k < last; ++k) {
+        const std::size_t i = entries[m].second, j = entries[k].second;
+        if ((i + 1) % n == j || (j + 1) % n == i) continue;  // neighbours: checked above
+        const auto [a, b] = side(i);
+        const auto [c, d] = side(j);
+        if (segments_meet(a, b, c, d, tol)) return false;
+      }
+    first = last;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool is_height_field(const SurfaceMesh& mesh) {
+  const int nf = int(mesh.n_faces());
+  auto twice_area_normal = [&](int f) {
+    const auto [a, b, c] = face_points(mesh, FaceHandle(f));
+    return Vec3((b - a) % (c - a));
+  };
+  auto live = [&](int f) { return !mesh.status(FaceHandle(f)).deleted(); };
+  // d: the mean normal, summed by fixed blocks (the same for any number of threads).
+  Vec3 d = reduce(
+      nf, Vec3(0, 0, 0), [&](int f, Vec3& sum) { if (live(f)) sum += twice_area_normal(f); },
+      [](Vec3& total, const Vec3& part) { total += part; });
+  const double length = d.norm();
+  if (!(length > 0)) return false;
+  d /= length;
+  const int turned_away = reduce(
+      nf, 0,
+      [&](int f, int& count) {
+        if (count > 0 || !live(f)) return;
+        const Vec3 n = twice_area_normal(f);
+        const double len = n.norm();
+        count += !(len > 0 && (n | d) >= kFacing * len);
+      },
+      [](int& total, int part) { total += part; });
+  if (turned_away > 0) return false;
+
+  // The boundary: one loop through every boundary vertex once.
+  const std::vector<int> boundary = collect<int>(int(mesh.n_vertices()), [&](int v, int& item) {
+    item = v;
+    const VertexHandle vh(v);
+    return !mesh.status(vh).deleted() && mesh.is_boundary(vh);
+  });
+  if (boundary.size() < 3) return false;
+  const HalfedgeHandle start = mesh.halfedge_handle(VertexHandle(boundary.front()));
+  if (!mesh.is_boundary(start)) return false;
+  // Its shadow, in a frame (u, v) of the plane normal to d.
+  const Vec3 u = (std::abs(d[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)) % d;
+  const Vec3 e1 = u / u.norm(), e2 = d % e1;
+  std::vector<Point2> shadow;
+  shadow.reserve(boundary.size());
+  HalfedgeHandle h = start;
+  do {
+    if (shadow.size() == boundary.size()) return false;  // a vertex twice: not one simple loop
+    const Vec3& p = mesh.point(mesh.from_vertex_handle(h));
+    shadow.push_back({p | e1, p | e2});
+    h = mesh.next_halfedge_handle(h);
+  } while (h != start);
+  if (shadow.size() != boundary.size()) return false;  // more than one loop
+  return is_simple_polygon(shadow);
+}
+
+}  // namespace bodyfit
