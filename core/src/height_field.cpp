@@ -94,13 +94,27 @@ bool is_height_field(const SurfaceMesh& mesh) {
     return Vec3((b - a) % (c - a));
   };
   auto live = [&](int f) { return !mesh.status(FaceHandle(f)).deleted(); };
-  // d: the mean normal, summed by fixed blocks (the same for any number of threads).
-  Vec3 d = reduce(
-      nf, Vec3(0, 0, 0), [&](int f, Vec3& sum) { if (live(f)) sum += twice_area_normal(f); },
-      [](Vec3& total, const Vec3& part) { total += part; });
-  const double length = d.norm();
-  if (!(length > 0)) return false;
-  d /= length;
+  // d: the mean normal, summed by fixed blocks (the same for any number of threads). Faces that
+  // all face d give |Σ n| = Σ n·d ≥ cos 84° Σ |n|: a closed surface (Σ n = 0) fails here.
+  struct Sums {
+    Vec3 normal{0, 0, 0};
+    double area = 0;
+  };
+  const Sums sums = reduce(
+      nf, Sums{},
+      [&](int f, Sums& s) {
+        if (!live(f)) return;
+        const Vec3 n = twice_area_normal(f);
+        s.normal += n;
+        s.area += n.norm();
+      },
+      [](Sums& total, const Sums& part) {
+        total.normal += part.normal;
+        total.area += part.area;
+      });
+  const double length = sums.normal.norm();
+  if (!(length > 0) || length < kFacing * sums.area) return false;
+  const Vec3 d = sums.normal / length;
   const int turned_away = reduce(
       nf, 0,
       [&](int f, int& count) {
