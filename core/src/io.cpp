@@ -288,7 +288,7 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
         const auto& tri = r.triangles[std::size_t(t)];
         const Vec3 &a = r.points[std::size_t(tri[0])], &b = r.points[std::size_t(tri[1])], &c = r.points[std::size_t(tri[2])];
         s.length += (b - a).norm() + (c - b).norm() + (a - c).norm();
-        if (const double a = area(t); !(a >= s.least_area)) s.least_area = a;  // a NaN too
+        if (const double at = area(t); !(at >= s.least_area)) s.least_area = at;  // a NaN too
       },
       [](Scale& total, const Scale& s) {
         total.length += s.length;

@@ -8,7 +8,7 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <numeric>
+#include <type_traits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -221,7 +221,6 @@ ReferenceSurface::ReferenceSurface(const SurfaceMesh& mesh) {
       std::array<int, 3>& t = tri_[std::size_t(k)];
       int c = 0;
       for (auto v : mesh.fv_range(FaceHandle(faces[std::size_t(k)]))) t[c++] = index[std::size_t(v.idx())];
-
       const Vec3 n = twice_area_normal(t);
       const double len = n.norm();
       normal_[std::size_t(k)] = len > 0 ? n / len : Vec3(0, 0, 0);
