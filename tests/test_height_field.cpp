@@ -88,6 +88,18 @@ TEST_CASE("not height fields: closed, two boundaries, faces turned edge-on, a sh
   const SurfaceMesh square = make_plane({.size = 2, .h = 0.1});
   CHECK_FALSE(is_height_field(keep_faces(square, [](const Vec3& c) { return c.norm() > 0.4; })));
   CHECK_FALSE(is_height_field(keep_faces(square, [](const Vec3& c) { return std::abs(c[0]) > 0.3; })));
+  // A vertex on no face (the first one, where the boundary's walk starts): not one loop.
+  SurfaceMesh lonely;
+  lonely.add_vertex(Vec3(5, 5, 5));
+  std::vector<VertexHandle> copy;
+  for (auto v : square.vertices()) copy.push_back(lonely.add_vertex(square.point(v)));
+  for (auto f : square.faces()) {
+    std::vector<VertexHandle> corners;
+    for (auto v : square.fv_range(f)) corners.push_back(copy[std::size_t(v.idx())]);
+    lonely.add_face(corners);
+  }
+  CHECK(is_height_field(keep_faces(lonely, [](const Vec3&) { return true; })));
+  CHECK_FALSE(is_height_field(lonely));
   // A ridge of slope 50 across the square, its faces within 2° of vertical: z(x, y) still, but
   // too steep to trust (a single wall would not do: the mean normal turns towards it, and the square
   // is a height field over the plane across that).

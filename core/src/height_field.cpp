@@ -134,7 +134,7 @@ bool is_height_field(const SurfaceMesh& mesh) {
   });
   if (boundary.size() < 3) return false;
   const HalfedgeHandle start = mesh.halfedge_handle(VertexHandle(boundary.front()));
-  if (!mesh.is_boundary(start)) return false;
+  if (!start.is_valid() || !mesh.is_boundary(start)) return false;  // an isolated vertex
   // Its shadow, in a frame (u, v) of the plane normal to d.
   const Vec3 u = (std::abs(d[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)) % d;
   const Vec3 e1 = u / u.norm(), e2 = d % e1;
