@@ -39,7 +39,7 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double tol) {
 
 /// Whether the closed polygon is simple: no two sides meet but neighbours at their common corner
 /// (and those do not fold back onto each other). Sides are paired through a grid of cells about a
-/// side long.
+/// side long; false also when that grid would be too large to tell (sides of very unequal lengths).
 bool is_simple_polygon(const std::vector<Point2>& corners) {
   const std::size_t n = corners.size();
   if (n < 3) return false;
@@ -61,17 +61,35 @@ bool is_simple_polygon(const std::vector<Point2>& corners) {
   }
   const double cell = std::max(perimeter / double(n), tol);
   auto index = [&](double x, double origin) { return std::int64_t(std::floor((x - origin) / cell)); };
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;  // (cell, side), sorted by cell
-  for (std::size_t i = 0; i < n; ++i) {
+  struct Cells {
+    std::int64_t x0, x1, y0, y1;  // the side's box, in cells
+  };
+  auto cells_of = [&](std::size_t i) {
     const auto [a, b] = side(i);
-    for (auto x = index(std::min(a.x, b.x) - tol, lo.x); x <= index(std::max(a.x, b.x) + tol, lo.x); ++x)
-      for (auto y = index(std::min(a.y, b.y) - tol, lo.y); y <= index(std::max(a.y, b.y) + tol, lo.y); ++y)
+    return Cells{index(std::min(a.x, b.x) - tol, lo.x), index(std::max(a.x, b.x) + tol, lo.x),
+                 index(std::min(a.y, b.y) - tol, lo.y), index(std::max(a.y, b.y) + tol, lo.y)};
+  };
+  // A side may cover many cells when the sides' lengths differ wildly: past a few per side on
+  // average the grid is not worth making, and the answer is "cannot tell".
+  double count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Cells c = cells_of(i);
+    count += double(c.x1 - c.x0 + 1) * double(c.y1 - c.y0 + 1);
+  }
+  if (count > 64.0 * double(n)) return false;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> entries;  // (cell, side), sorted by cell
+  entries.reserve(std::size_t(count));
+  for (std::size_t i = 0; i < n; ++i) {
+    const Cells c = cells_of(i);
+    for (auto x = c.x0; x <= c.x1; ++x)
+      for (auto y = c.y0; y <= c.y1; ++y)
         entries.emplace_back((std::uint64_t(x + 1) << 32) | std::uint64_t(y + 1), std::uint32_t(i));
   }
   std::sort(entries.begin(), entries.end());
   for (std::size_t first = 0; first < entries.size();) {
     std::size_t last = first;
     while (last < entries.size() && entries[last].first == entries[first].first) ++last;
+    if (last - first > 256) return false;  // a crowd of tiny sides: not worth every pair
     for (std::size_t m = first; m < last; ++m)
       for (std::size_t k = m + 1; k < last; ++k) {
         const std::size_t i = entries[m].second, j = entries[k].second;
