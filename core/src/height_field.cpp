@@ -2,6 +2,7 @@
 #include <bodyfit/height_field.hpp>
 
 #include <bodyfit/geometry.hpp>
+#include <bodyfit/projection.hpp>
 
 #include "blocks.hpp"
 
@@ -17,20 +18,16 @@ namespace {
 constexpr double kFacing = 0.1;        // cos 84°: a face steeper than that is not trusted to face d
 constexpr double kTouching = 1e-9;     // of the shadow's size: closer than that counts as touching
 
-struct Point2 {
-  double x, y;
-};
+// The boundary's shadow: points of the plane as Vec3 with z = 0, so that the segment helpers of
+// the projection serve.
+double cross2(const Vec3& o, const Vec3& a, const Vec3& b) { return ((a - o) % (b - o))[2]; }
 
-double cross2(Point2 o, Point2 a, Point2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
-
-double distance_to_segment(Point2 p, Point2 a, Point2 b) {
-  const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
-  const double t = l2 > 0 ? std::clamp(((p.x - a.x) * dx + (p.y - a.y) * dy) / l2, 0.0, 1.0) : 0.0;
-  return std::hypot(a.x + t * dx - p.x, a.y + t * dy - p.y);
+double distance_to_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  return (closest_point_on_segment(p, a, b) - p).norm();
 }
 
 /// Whether the segments ab and cd cross or come within `tol` of each other.
-bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double tol) {
+bool segments_meet(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double tol) {
   const double o1 = cross2(a, b, c), o2 = cross2(a, b, d), o3 = cross2(c, d, a), o4 = cross2(c, d, b);
   if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
   return distance_to_segment(c, a, b) <= tol || distance_to_segment(d, a, b) <= tol ||
@@ -40,23 +37,22 @@ bool segments_meet(Point2 a, Point2 b, Point2 c, Point2 d, double tol) {
 /// Whether the closed polygon is simple: no two sides meet but neighbours at their common corner
 /// (and those do not fold back onto each other). Sides are paired through a grid of cells about a
 /// side long; false also when that grid would be too large to tell (sides of very unequal lengths).
-bool is_simple_polygon(const std::vector<Point2>& corners) {
+bool is_simple_polygon(const std::vector<Vec3>& corners) {
   const std::size_t n = corners.size();
   if (n < 3) return false;
-  Point2 lo = corners[0], hi = corners[0];
+  Vec3 lo = corners[0], hi = corners[0];
   double perimeter = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const Point2 p = corners[i], q = corners[(i + 1) % n];
-    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y)};
-    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
-    perimeter += std::hypot(q.x - p.x, q.y - p.y);
+    lo.minimize(corners[i]);
+    hi.maximize(corners[i]);
+    perimeter += (corners[(i + 1) % n] - corners[i]).norm();
   }
-  const double tol = kTouching * std::hypot(hi.x - lo.x, hi.y - lo.y);
+  const double tol = kTouching * (hi - lo).norm();
   if (!(tol > 0)) return false;
   auto side = [&](std::size_t i) { return std::pair{corners[i], corners[(i + 1) % n]}; };
   for (std::size_t i = 0; i < n; ++i) {  // neighbours: only their common corner
     const auto [a, b] = side(i);
-    const Point2 c = corners[(i + 2) % n];
+    const Vec3& c = corners[(i + 2) % n];
     if (distance_to_segment(c, a, b) <= tol || distance_to_segment(a, b, c) <= tol) return false;
   }
   const double cell = std::max(perimeter / double(n), tol);
@@ -66,8 +62,8 @@ bool is_simple_polygon(const std::vector<Point2>& corners) {
   };
   auto cells_of = [&](std::size_t i) {
     const auto [a, b] = side(i);
-    return Cells{index(std::min(a.x, b.x) - tol, lo.x), index(std::max(a.x, b.x) + tol, lo.x),
-                 index(std::min(a.y, b.y) - tol, lo.y), index(std::max(a.y, b.y) + tol, lo.y)};
+    return Cells{index(std::min(a[0], b[0]) - tol, lo[0]), index(std::max(a[0], b[0]) + tol, lo[0]),
+                 index(std::min(a[1], b[1]) - tol, lo[1]), index(std::max(a[1], b[1]) + tol, lo[1])};
   };
   // A side may cover many cells when the sides' lengths differ wildly: past a few per side on
   // average the grid is not worth making, and the answer is "cannot tell".
@@ -156,13 +152,13 @@ bool is_height_field(const SurfaceMesh& mesh) {
   // Its shadow, in a frame (u, v) of the plane normal to d.
   const Vec3 u = (std::abs(d[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0)) % d;
   const Vec3 e1 = u / u.norm(), e2 = d % e1;
-  std::vector<Point2> shadow;
+  std::vector<Vec3> shadow;
   shadow.reserve(boundary.size());
   HalfedgeHandle h = start;
   do {
     if (shadow.size() == boundary.size()) return false;  // a vertex twice: not one simple loop
     const Vec3& p = mesh.point(mesh.from_vertex_handle(h));
-    shadow.push_back({p | e1, p | e2});
+    shadow.emplace_back(p | e1, p | e2, 0.0);
     h = mesh.next_halfedge_handle(h);
   } while (h != start);
   if (shadow.size() != boundary.size()) return false;  // more than one loop
