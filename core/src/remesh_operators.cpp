@@ -425,9 +425,15 @@ void Remesher::flip_edge(EdgeHandle e) {
 }
 
 
+// Smooth v: its ring's centroid in its tangent plane (a curve vertex: its curve neighbours' middle
+// on the curve), projected onto S, when the move is legal and improves v's star. Returns how far v
+// went, negative when it stays. Reads the places of v's ring and of the far corners of the triangles
+// across the ring's sides, the hint faces of v and its ring, and writes only v's place, hint face
+// and normal: relocate_in_waves runs it from several threads on that contract.
 double Remesher::relocate(VertexHandle v) {
+  constexpr double kStays = -1;
   char kind = m_.property(kind_, v);
-  if (kind == kLockedVertex || kind == kCornerVertex || m_.is_isolated(v)) return 0;
+  if (kind == kLockedVertex || kind == kCornerVertex || m_.is_isolated(v)) return kStays;
   const Vec3 p = m_.point(v);
   Vec3 target(0, 0, 0);
   if (kind == kFreeVertex) {
@@ -436,33 +442,33 @@ double Remesher::relocate(VertexHandle v) {
     target = p + d - nv * (d | nv);
   } else {
     auto ends = curve_neighbours(v);
-    if (!ends) return 0;
+    if (!ends) return kStays;
     target = project_on_curve((m_.point(ends->first) + m_.point(ends->second)) / 2.0, m_.property(vcurve_, v));
   }
   Vec3 q;
   SurfacePoint sp;
   Change change;
-  if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change) || move_lengthens(v, q)) return 0;
+  if (!place(v, target, q, sp) || !move_check(v, q, sp.normal, change) || move_lengthens(v, q)) return kStays;
   if (check_distance_) {
-    std::vector<std::array<VertexHandle, 3>>& star = after_;
-    star.clear();
+    std::array<std::array<VertexHandle, 3>, kMaxValence> star;  // move_check refused a larger valence
+    std::size_t n = 0;
     for (auto h : m_.voh_range(v))
-      if (!m_.is_boundary(h)) star.push_back({v, m_.to_vertex_handle(h), m_.to_vertex_handle(m_.next_halfedge_handle(h))});
-    if (!near_surface(p, star, v, q)) return 0;
+      if (!m_.is_boundary(h)) star[n++] = {v, m_.to_vertex_handle(h), m_.to_vertex_handle(m_.next_halfedge_handle(h))};
+    if (!near_surface(p, std::span(star.data(), n), v, q)) return kStays;
     for (auto w : m_.vv_range(v))
       if (!chord_within_hausd(v, q, m_.point(w), p, m_.point(w), {sp.face, m_.property(hint_, w), m_.property(hint_, v)}))
-        return 0;
+        return kStays;
   }
   // Curve vertices move only to repair a poor triangle: a point between the reference curve's
   // vertices lies on a chord, off the true curve by up to h²κ/8.
-  if (kind == kCurveVertex && change.old_min >= kCurveRepairQuality) return 0;
+  if (kind == kCurveVertex && change.old_min >= kCurveRepairQuality) return kStays;
   // A better worst triangle, or (trading a little of it for the others) a better sum when every
   // triangle stays ≥ 0.6 — but not for a star already good everywhere: smoothing it would only lower
   // its worst triangle towards the others.
   bool better = change.new_min >= change.old_min ||
                 (change.new_min >= 0.6 && change.old_min < kSmoothBelow && change.new_sum > change.old_sum);
-  if (!better) return 0;
-  move_vertex(v, q, sp);
+  if (!better) return kStays;
+  set_place(v, q, sp);
   return (q - p).norm();
 }
 
@@ -559,9 +565,7 @@ bool Remesher::move_lengthens(VertexHandle v, const Vec3& q) const {
 
 void Remesher::move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
   touch(v);
-  m_.set_point(v, q);
-  m_.property(hint_, v) = sp.face;
-  m_.property(vnormal_, v) = sp.normal;
+  set_place(v, q, sp);
   ++report_.relocations;
 }
 

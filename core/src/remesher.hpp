@@ -169,7 +169,7 @@ class Remesher {
     // the compaction that follows reuses that memory instead of growing the heap.
     ref_.reset();
     curves_ = ReferencePolyline();
-    release_buffers(work_, next_, touched_list_, edges_, ranked_, rated_, projected_, worth_flipping_, face_flipped_,
+    release_buffers(work_, next_, moved_, listed_, touched_list_, edges_, ranked_, rated_, projected_, worth_flipping_, face_flipped_,
                     flipped_faces_, star_, after_, normals_);
   }
   template <class... Vectors>
@@ -245,10 +245,17 @@ class Remesher {
   bool feature_flip_check(HalfedgeHandle h, Change& change) const;
   void feature_flip(HalfedgeHandle h);
   void classify_vertex(VertexHandle v);
+  void relocate_in_waves(std::size_t count, std::vector<double>& moved);
   double relocate(VertexHandle v);
   bool place(VertexHandle v, const Vec3& target, Vec3& q, SurfacePoint& sp) const;
   bool move_check(VertexHandle v, const Vec3& q, const Vec3& normal, Change& change) const;
   void move_vertex(VertexHandle v, const Vec3& q, const SurfacePoint& sp);
+  /// v at q, S's point sp: its place, hint face and normal (what a relocation writes).
+  void set_place(VertexHandle v, const Vec3& q, const SurfacePoint& sp) {
+    m_.set_point(v, q);
+    m_.property(hint_, v) = sp.face;
+    m_.property(vnormal_, v) = sp.normal;
+  }
   bool folds(std::span<const std::array<VertexHandle, 3>> triangles, std::span<const FaceHandle> replaced,
              VertexHandle moved = VertexHandle(), const Vec3& at = Vec3(0, 0, 0)) const;
   bool move_lengthens(VertexHandle v, const Vec3& q) const;
@@ -307,6 +314,8 @@ class Remesher {
   OpenMesh::EPropHandleT<char> ecurve_;
   bool released_ = false;
   std::vector<VertexHandle> work_, next_;
+  std::vector<double> moved_;  // how far each relocated vertex of a pass went (relocate_in_waves)
+  std::vector<int> listed_;    // each vertex's place in the pass's list, −1 (relocate_in_waves)
   // Scratch buffers reused by every pass and check (no allocation per operation).
   std::vector<EdgeHandle> edges_;
   std::vector<std::pair<double, EdgeHandle>> ranked_, rated_;

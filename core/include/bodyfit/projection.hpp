@@ -90,6 +90,9 @@ class ReferencePolyline {
   /// Closest point to p on the segments with `label`; returns p when there is none.
   Vec3 closest(const Vec3& p, int label) const;
   std::size_t size() const { return a_.size(); }
+  /// Build the search tree now: closest() may then be called from several threads at once (until
+  /// the next add() or smooth()). Otherwise the first query builds it.
+  void prepare() const { ensure_tree(); }
   /// Replace the chords carrying `label` by a C¹ curve through the same vertices, so that points
   /// put on the curve (split midpoints, relocated vertices) stay on the smooth curve the polyline
   /// samples instead of falling inside it by the sagitta. Each segment becomes a cubic Hermite arc
