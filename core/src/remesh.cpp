@@ -1,25 +1,18 @@
 // Interface-preserving adaptive remeshing: split / collapse / flip / relocate driven by a sizing
 // field, on a work queue of "active" vertices so that the cost follows the part of the mesh that
 // needs change. See docs/validation/remeshing.md for the algorithm and its defaults; the Remesher
-// class is in remesher.hpp, its operators, features and repair in remesh_*.cpp.
+// class is in remesher.hpp, its operators, features, repair and parallel relocations in remesh_*.cpp.
 #include "remesher.hpp"
 
 #include <bodyfit/error.hpp>
 #include <bodyfit/guards.hpp>
 
 #include <fmt/format.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_sort.h>
-#include <tbb/task_arena.h>
-#include <tbb/task_group.h>
 #include <spdlog/spdlog.h>
 #include <sys/resource.h>
 
-#include <atomic>
 #include <ctime>
-#include <exception>
-#include <memory>
-#include <thread>
 
 namespace bodyfit {
 namespace remesh_detail {
@@ -236,95 +229,6 @@ void Remesher::split_long_edges() {
   // The split rounds' projections (tens of MB for a large refinement) are not read by the passes:
   // freed here, their memory serves the passes instead of the heap growing beside it.
   release_buffers(projected_);
-}
-
-// The relocations of work_[0, count) as one loop over the list in its order makes them: each vertex
-// sees the new places of the vertices listed before it and the old places of those after. A
-// relocation reads the places of the vertex's ring and of the far corners of the triangles across
-// the ring's sides (and the ring's hint faces), and writes only its own vertex's. So the vertices
-// are ordered by wave (one wave after the latest of the listed-before vertices it reads: a wave's
-// vertices read nothing another of them writes), the threads take that order in chunks, and a
-// vertex waits for the listed-before vertices it reads. Those are all earlier in the order, so the
-// earliest vertex in progress never waits. The same places, hints and normals as the loop, bit for
-// bit, for any number of threads. moved[i]: how far work_[i] went, negative when it stayed (or is
-// deleted).
-void Remesher::relocate_in_waves(std::size_t count, std::vector<double>& moved) {
-  moved.assign(count, -1.0);
-  constexpr std::size_t kWavesFrom = 512;  // below, the bookkeeping outweighs the second thread
-  const int threads = int(std::min<std::size_t>(std::size_t(tbb::this_task_arena::max_concurrency()),
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
-  if (count < kWavesFrom || threads < 2) {
-    for (std::size_t i = 0; i < count; ++i)
-      if (!m_.status(work_[i]).deleted()) moved[i] = relocate(work_[i]);
-    return;
-  }
-  curves_.prepare();  // its search tree, before the threads query it
-  if (listed_.size() < m_.n_vertices()) listed_.resize(m_.n_vertices(), -1);
-  for (std::size_t i = 0; i < count; ++i)
-    if (!m_.status(work_[i]).deleted()) listed_[std::size_t(work_[i].idx())] = int(i);
-  // Each vertex's wave and the listed-before vertices it reads.
-  std::vector<int> wave(count, -1), reads_from(count + 1, 0), reads;
-  reads.reserve(8 * count);
-  int waves = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    reads_from[i] = int(reads.size());
-    const VertexHandle v = work_[i];
-    if (m_.status(v).deleted()) continue;
-    int w = 0;
-    auto read = [&](VertexHandle u) {
-      const int j = listed_[std::size_t(u.idx())];
-      if (j < 0 || std::size_t(j) >= i) return;
-      reads.push_back(j);
-      w = std::max(w, wave[std::size_t(j)] + 1);
-    };
-    for (auto h : m_.voh_range(v)) {
-      read(m_.to_vertex_handle(h));
-      if (m_.is_boundary(h)) continue;
-      const auto outer = m_.opposite_halfedge_handle(m_.next_halfedge_handle(h));
-      if (!m_.is_boundary(outer)) read(m_.to_vertex_handle(m_.next_halfedge_handle(outer)));
-    }
-    wave[i] = w;
-    waves = std::max(waves, w + 1);
-  }
-  reads_from[count] = int(reads.size());
-  for (std::size_t i = 0; i < count; ++i) listed_[std::size_t(work_[i].idx())] = -1;
-  // The list's indices by wave (a counting sort).
-  std::vector<int> order, next(std::size_t(waves) + 1, 0);
-  for (int w : wave)
-    if (w >= 0) ++next[std::size_t(w) + 1];
-  for (int w = 0; w < waves; ++w) next[std::size_t(w) + 1] += next[std::size_t(w)];
-  order.resize(std::size_t(next[std::size_t(waves)]));
-  for (std::size_t i = 0; i < count; ++i)
-    if (wave[i] >= 0) order[std::size_t(next[std::size_t(wave[i])]++)] = int(i);
-  const int total = int(order.size());
-  std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[count]);
-  for (std::size_t i = 0; i < count; ++i) done[i].store(false, std::memory_order_relaxed);
-  std::atomic<int> taken{0};
-  std::atomic<bool> failed{false};  // a relocation threw: the others stop rather than wait for it
-  std::exception_ptr error;
-  auto take_chunks = [&] {
-    constexpr int kChunk = 8;  // relocations per take: each a microsecond or two
-    try {
-      for (int begin; (begin = taken.fetch_add(kChunk, std::memory_order_relaxed)) < total;)
-        for (int k = begin; k < std::min(begin + kChunk, total); ++k) {
-          const auto i = std::size_t(order[std::size_t(k)]);
-          for (int r = reads_from[i]; r < reads_from[i + 1]; ++r)
-            while (!done[std::size_t(reads[std::size_t(r)])].load(std::memory_order_acquire)) {
-              if (failed.load(std::memory_order_relaxed)) return;
-              std::this_thread::yield();
-            }
-          moved[i] = relocate(work_[i]);
-          done[i].store(true, std::memory_order_release);
-        }
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-    }
-  };
-  tbb::task_group helpers;
-  for (int t = 1; t < threads; ++t) helpers.run(take_chunks);
-  take_chunks();
-  helpers.wait();
-  if (error) std::rethrow_exception(error);
 }
 
 // One collapse/flip/relocate pass over the work queue (with a split step for edges made long since);
