@@ -204,8 +204,10 @@ TEST_CASE("refining a sphere ×3 and ×10 in one call: no edge above the split b
 
 TEST_CASE("remeshing to a size gives the same arrays with one thread and with two") {
   // Refined ×3, the work lists and a split round's edges span many blocks of the parallel gathers
-  // (work edges, midpoint projections, flip screening); fandisk's creases turn the distance checks
-  // on (a chord's sag proven from the triangles at its ends, or searched).
+  // (work edges, midpoint projections, flip screening), and the first pass queues every split's
+  // vertex: one thread relocates them in a loop, two in waves (remesh_waves.cpp), which must move
+  // each vertex as the loop does. fandisk's creases turn the distance checks on (a chord's sag
+  // proven from the triangles at its ends, or searched).
   const auto fandisk = read_mesh(fs::path(BODYFIT_SOURCE_DIR) / "meshes/public/fandisk.off");
   for (const auto& named : {std::pair{"sphere", make_sphere({.faces = 8000})}, std::pair{"fandisk", fandisk}}) {
     const std::string name = named.first;
