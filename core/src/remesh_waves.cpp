@@ -41,6 +41,67 @@ struct ListedReads {
   }
 };
 
+/// The list's indices ordered by wave, list order within a wave (a counting sort): an item's wave is
+/// one after the latest wave among its reads. `live(i)`: whether item i is run at all.
+template <class Live>
+std::vector<int> order_by_wave(const ListedReads& reads, std::size_t count, Live&& live) {
+  std::vector<int> wave(count, -1);
+  int waves = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!live(i)) continue;
+    int w = 0;
+    for (int j : reads.of(i)) w = std::max(w, wave[std::size_t(j)] + 1);
+    wave[i] = w;
+    waves = std::max(waves, w + 1);
+  }
+  std::vector<int> order, next(std::size_t(waves) + 1, 0);
+  for (int w : wave)
+    if (w >= 0) ++next[std::size_t(w) + 1];
+  for (int w = 0; w < waves; ++w) next[std::size_t(w) + 1] += next[std::size_t(w)];
+  order.resize(std::size_t(next[std::size_t(waves)]));
+  for (std::size_t i = 0; i < count; ++i)
+    if (wave[i] >= 0) order[std::size_t(next[std::size_t(wave[i])]++)] = int(i);
+  return order;
+}
+
+/// run(i) for every item of `order` on `threads` threads, each once its reads have run: the threads
+/// take `order` in chunks, and an item waits until its reads are done. Its reads come before it in
+/// `order`, so the earliest item in progress never waits. An exception stops the others (rather
+/// than leave them waiting for the item that threw) and is rethrown.
+template <class Run>
+void run_after_reads(const std::vector<int>& order, const ListedReads& reads, std::size_t count, int threads,
+                     Run&& run) {
+  const int total = int(order.size());
+  std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[count]);
+  for (std::size_t i = 0; i < count; ++i) done[i].store(false, std::memory_order_relaxed);
+  std::atomic<int> taken{0};
+  std::atomic<bool> failed{false};
+  std::exception_ptr error;
+  auto take_chunks = [&] {
+    constexpr int kChunk = 8;  // items per take: a relocation is a microsecond or so
+    try {
+      for (int begin; (begin = taken.fetch_add(kChunk, std::memory_order_relaxed)) < total;)
+        for (int k = begin; k < std::min(begin + kChunk, total); ++k) {
+          const auto i = std::size_t(order[std::size_t(k)]);
+          for (int j : reads.of(i))
+            while (!done[std::size_t(j)].load(std::memory_order_acquire)) {
+              if (failed.load(std::memory_order_relaxed)) return;
+              std::this_thread::yield();
+            }
+          run(i);
+          done[i].store(true, std::memory_order_release);
+        }
+    } catch (...) {
+      if (!failed.exchange(true)) error = std::current_exception();
+    }
+  };
+  tbb::task_group helpers;
+  for (int t = 1; t < threads; ++t) helpers.run(take_chunks);
+  take_chunks();
+  helpers.wait();
+  if (error) std::rethrow_exception(error);
+}
+
 }  // namespace
 
 void Remesher::relocate_in_waves(std::size_t count, std::vector<double>& moved) {
@@ -57,12 +118,14 @@ void Remesher::relocate_in_waves(std::size_t count, std::vector<double>& moved) 
   }
   curves_.prepare();  // its search tree, before the threads query it
 
+  const auto live = [&](std::size_t i) { return !m_.status(work_[i]).deleted(); };
   auto each_listed = [&](auto&& body) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, ListedReads::kBlock), [&](const auto& range) {
       for (std::size_t i = range.begin(); i < range.end(); ++i)
-        if (!m_.status(work_[i]).deleted()) body(i, work_[i]);
+        if (live(i)) body(i, work_[i]);
     });
   };
+  // Each live vertex's reads, found through listed_ (each vertex's place in the list, −1 between passes).
   if (listed_.size() < m_.n_vertices()) listed_.resize(m_.n_vertices(), -1);
   each_listed([&](std::size_t i, VertexHandle v) { listed_[std::size_t(v.idx())] = int(i); });
   ListedReads reads(count);
@@ -76,7 +139,7 @@ void Remesher::relocate_in_waves(std::size_t count, std::vector<double>& moved) 
           const int j = listed_[std::size_t(u.idx())];
           if (j >= 0 && std::size_t(j) < i) block.push_back(j);
         };
-        if (!m_.status(v).deleted())
+        if (live(i))
           for (auto h : m_.voh_range(v)) {
             read(m_.to_vertex_handle(h));
             if (m_.is_boundary(h)) continue;
@@ -89,53 +152,8 @@ void Remesher::relocate_in_waves(std::size_t count, std::vector<double>& moved) 
   });
   each_listed([&](std::size_t, VertexHandle v) { listed_[std::size_t(v.idx())] = -1; });
 
-  // The waves in list order, then the list's indices by wave (a counting sort).
-  std::vector<int> wave(count, -1);
-  int waves = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    if (m_.status(work_[i]).deleted()) continue;
-    int w = 0;
-    for (int j : reads.of(i)) w = std::max(w, wave[std::size_t(j)] + 1);
-    wave[i] = w;
-    waves = std::max(waves, w + 1);
-  }
-  std::vector<int> order, next(std::size_t(waves) + 1, 0);
-  for (int w : wave)
-    if (w >= 0) ++next[std::size_t(w) + 1];
-  for (int w = 0; w < waves; ++w) next[std::size_t(w) + 1] += next[std::size_t(w)];
-  order.resize(std::size_t(next[std::size_t(waves)]));
-  for (std::size_t i = 0; i < count; ++i)
-    if (wave[i] >= 0) order[std::size_t(next[std::size_t(wave[i])]++)] = int(i);
-
-  const int total = int(order.size());
-  std::unique_ptr<std::atomic<bool>[]> done(new std::atomic<bool>[count]);
-  for (std::size_t i = 0; i < count; ++i) done[i].store(false, std::memory_order_relaxed);
-  std::atomic<int> taken{0};
-  std::atomic<bool> failed{false};  // a relocation threw: the others stop rather than wait for it
-  std::exception_ptr error;
-  auto take_chunks = [&] {
-    constexpr int kChunk = 8;  // relocations per take: each a microsecond or so
-    try {
-      for (int begin; (begin = taken.fetch_add(kChunk, std::memory_order_relaxed)) < total;)
-        for (int k = begin; k < std::min(begin + kChunk, total); ++k) {
-          const auto i = std::size_t(order[std::size_t(k)]);
-          for (int j : reads.of(i))
-            while (!done[std::size_t(j)].load(std::memory_order_acquire)) {
-              if (failed.load(std::memory_order_relaxed)) return;
-              std::this_thread::yield();
-            }
-          moved[i] = relocate(work_[i]);
-          done[i].store(true, std::memory_order_release);
-        }
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-    }
-  };
-  tbb::task_group helpers;
-  for (int t = 1; t < threads; ++t) helpers.run(take_chunks);
-  take_chunks();
-  helpers.wait();
-  if (error) std::rethrow_exception(error);
+  run_after_reads(order_by_wave(reads, count, live), reads, count, threads,
+                  [&](std::size_t i) { moved[i] = relocate(work_[i]); });
 }
 
 }  // namespace bodyfit::remesh_detail
