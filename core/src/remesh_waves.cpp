@@ -66,8 +66,11 @@ std::vector<int> order_by_wave(const ListedReads& reads, std::size_t count, Live
 
 /// run(i) for every item of `order` on `threads` threads, each once its reads have run: the threads
 /// take `order` in chunks, and an item waits until its reads are done. Its reads come before it in
-/// `order`, so the earliest item in progress never waits. An exception stops the others (rather
-/// than leave them waiting for the item that threw) and is rethrown.
+/// `order`, so the earliest item in progress never waits. Each thread's chunks run isolated: a
+/// parallel loop inside run(i) (a search structure built on first use) waits by running tasks, and
+/// must not run another thread's share of the chunks there, which could wait for the item below it
+/// on the same thread. An exception stops the others (rather than leave them waiting for the item
+/// that threw) and is rethrown.
 template <class Run>
 void run_after_reads(const std::vector<int>& order, const ListedReads& reads, std::size_t count, int threads,
                      Run&& run) {
@@ -79,21 +82,23 @@ void run_after_reads(const std::vector<int>& order, const ListedReads& reads, st
   std::exception_ptr error;
   auto take_chunks = [&] {
     constexpr int kChunk = 8;  // items per take: a relocation is a microsecond or so
-    try {
-      for (int begin; (begin = taken.fetch_add(kChunk, std::memory_order_relaxed)) < total;)
-        for (int k = begin; k < std::min(begin + kChunk, total); ++k) {
-          const auto i = std::size_t(order[std::size_t(k)]);
-          for (int j : reads.of(i))
-            while (!done[std::size_t(j)].load(std::memory_order_acquire)) {
-              if (failed.load(std::memory_order_relaxed)) return;
-              std::this_thread::yield();
-            }
-          run(i);
-          done[i].store(true, std::memory_order_release);
-        }
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-    }
+    tbb::this_task_arena::isolate([&] {
+      try {
+        for (int begin; (begin = taken.fetch_add(kChunk, std::memory_order_relaxed)) < total;)
+          for (int k = begin; k < std::min(begin + kChunk, total); ++k) {
+            const auto i = std::size_t(order[std::size_t(k)]);
+            for (int j : reads.of(i))
+              while (!done[std::size_t(j)].load(std::memory_order_acquire)) {
+                if (failed.load(std::memory_order_relaxed)) return;
+                std::this_thread::yield();
+              }
+            run(i);
+            done[i].store(true, std::memory_order_release);
+          }
+      } catch (...) {
+        if (!failed.exchange(true)) error = std::current_exception();
+      }
+    });
   };
   tbb::task_group helpers;
   for (int t = 1; t < threads; ++t) helpers.run(take_chunks);
