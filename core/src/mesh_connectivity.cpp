@@ -72,7 +72,8 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
     });
   };
 
-  // Twins; a side used twice in one direction, or a triangle repeated the other way round, is not a
+  // Twins, each pair found once, from its smaller vertex a (which alone writes both sides of it);
+  // a side used twice in one direction, or a triangle repeated the other way round, is not a
   // manifold surface.
   Array twin(std::size_t(nk), -1);
   over_vertices([&](int a) {
@@ -81,11 +82,13 @@ bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64
       const int k = out[std::size_t(i)], b = out_to[std::size_t(i)];
       for (int i2 = i + 1; i2 < end_a; ++i2)
         if (out_to[std::size_t(i2)] == b) return false;
+      if (b < a) continue;
       for (int j_at = first_out[std::size_t(b)]; j_at < first_out[std::size_t(b) + 1]; ++j_at) {
         if (out_to[std::size_t(j_at)] != a) continue;
         const int j = out[std::size_t(j_at)];
         if (from(previous_in_triangle(k)) == from(previous_in_triangle(j))) return false;
         twin[std::size_t(k)] = j;
+        twin[std::size_t(j)] = k;
       }
     }
     return true;
