@@ -424,7 +424,6 @@ void Remesher::flip_edge(EdgeHandle e) {
   for (auto v : quad) mark_fresh(v);
 }
 
-
 // Smooth v: its ring's centroid in its tangent plane (a curve vertex: its curve neighbours' middle
 // on the curve), projected onto S, when the move is legal and improves v's star. Returns how far v
 // went, negative when it stays. Reads the places of v's ring and of the far corners of the triangles

@@ -169,8 +169,8 @@ class Remesher {
     // the compaction that follows reuses that memory instead of growing the heap.
     ref_.reset();
     curves_ = ReferencePolyline();
-    release_buffers(work_, next_, moved_, listed_, touched_list_, edges_, ranked_, rated_, projected_, worth_flipping_, face_flipped_,
-                    flipped_faces_, star_, after_, normals_);
+    release_buffers(work_, next_, moved_, listed_, touched_list_, edges_, ranked_, rated_, projected_,
+                    worth_flipping_, face_flipped_, flipped_faces_, star_, after_, normals_);
   }
   template <class... Vectors>
   static void release_buffers(Vectors&... vectors) {
