@@ -1,11 +1,11 @@
 // Mesh I/O: format dispatch and the validated builder shared by every reader.
 #include "blocks.hpp"
 #include "io_internal.hpp"
-#include "mesh_connectivity.hpp"
 
 #include <bodyfit/atomic_file.hpp>
 #include <bodyfit/error.hpp>
 #include <bodyfit/io.hpp>
+#include <bodyfit/mesh_connectivity.hpp>
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>

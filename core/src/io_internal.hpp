@@ -10,6 +10,8 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace bodyfit::io_detail {
@@ -35,6 +37,17 @@ struct BulkAllocator {
   void deallocate(T* p, std::size_t n) noexcept {
     if (n * sizeof(T) < kBulkThreshold) std::allocator<T>().deallocate(p, n);
     else bulk_free(p, n * sizeof(T));
+  }
+  /// An element made without a value (resize(n), emplace_back()) is left default-initialised, not
+  /// zeroed: every reader writes each record it sizes for, and zeroing them first costs as much as
+  /// a fast parse.
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   friend bool operator==(const BulkAllocator&, const BulkAllocator&) { return true; }
 };

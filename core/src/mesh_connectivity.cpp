@@ -1,5 +1,5 @@
 // The halfedge connectivity of a triangle mesh from its corners: add_face's arrays without add_face.
-#include "mesh_connectivity.hpp"
+#include <bodyfit/mesh_connectivity.hpp>
 
 #include "io_internal.hpp"
 
@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -17,174 +19,228 @@ namespace bodyfit {
 namespace {
 
 // Working arrays on huge pages (io_internal.hpp): they are as big as the mesh and freshly touched.
-using Array = io_detail::BulkVector<int>;
+// Sized without a value, their elements are not zeroed.
+template <class T>
+using Array = io_detail::BulkVector<T>;
 
-// Triangle t's side i is the "corner halfedge" k = 3t + i, from corner i to corner i + 1.
+using Corners = std::span<const std::array<std::int64_t, 3>>;
+
+// Triangle t's side i is the "corner halfedge" k = 3t + i, from corner i to corner i + 1; the
+// triangle's third corner, i + 2, is the side's opposite corner.
 constexpr int next_in_triangle(int k) { return k % 3 == 2 ? k - 2 : k + 1; }
 constexpr int previous_in_triangle(int k) { return k % 3 == 0 ? k + 2 : k - 1; }
 
 constexpr int kGrain = 4096;  // elements per parallel task
 constexpr int kMaxChunks = 8;  // of the counting sort (each counts over every vertex)
 
-}  // namespace
+template <class Body>
+void in_blocks(int n, Body&& body) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, kGrain), [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
+}
 
-bool build_connectivity(SurfaceMesh& mesh, std::span<const std::array<std::int64_t, 3>> corners) {
-  const int nv = int(mesh.n_vertices());
-  const int nk = 3 * int(corners.size());
-  auto from = [&](int k) { return int(corners[std::size_t(k / 3)][std::size_t(k % 3)]); };
-  Array to(std::size_t(nk), 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, nk, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int k = r.begin(); k < r.end(); ++k) to[std::size_t(k)] = from(next_in_triangle(k));
+// A side as its first vertex lists it: which side, where it goes, and the opposite corner.
+struct Side {
+  int k, to, opposite;
+};
+
+/// Each vertex's sides, in side order: vertex v's are sides[first[v], first[v + 1]).
+struct SidesByVertex {
+  Array<int> first;
+  Array<Side> sides;
+};
+
+/// A counting sort by chunks of triangles: each chunk counts its sides per vertex, and places
+/// them after those of the chunks before (the arrays one pass in side order would give).
+SidesByVertex sides_by_vertex(Corners corners, int nv) {
+  const int nt = int(corners.size()), nk = 3 * nt;
+  auto corner = [&](int t, int i) { return int(corners[std::size_t(t)][std::size_t(i)]); };
+  SidesByVertex s{Array<int>(std::size_t(nv) + 1, 0), Array<Side>(std::size_t(nk))};  // sides: written below
+  const int chunks = std::clamp(std::min(nk / (16 * kGrain), tbb::this_task_arena::max_concurrency()), 1, kMaxChunks);
+  auto chunk_begin = [&](int c) { return int(std::int64_t(nt) * c / chunks); };
+  std::vector<Array<int>> at(std::size_t(chunks), Array<int>(std::size_t(nv), 0));  // count, then next place
+  tbb::parallel_for(0, chunks, [&](int c) {
+    int* count = at[std::size_t(c)].data();
+    for (int t = chunk_begin(c); t < chunk_begin(c + 1); ++t)
+      for (int i = 0; i < 3; ++i) ++count[corner(t, i)];
   });
-
-  // Each vertex's outgoing corner halfedges in triangle order, and beside them where each one goes
-  // (the twin search below then reads one vertex's sides from two short runs of memory).
-  // A counting sort by chunks of sides: each chunk counts its sides per vertex, and places them
-  // after those of the chunks before (the same arrays as one pass in side order).
-  Array first_out(std::size_t(nv) + 1, 0), out(std::size_t(nk), 0), out_to(std::size_t(nk), 0);
-  {
-    const int chunks = std::clamp(std::min(nk / (16 * kGrain), tbb::this_task_arena::max_concurrency()), 1, kMaxChunks);
-    auto chunk_begin = [&](int c) { return int(std::int64_t(nk) * c / chunks); };
-    std::vector<Array> at(std::size_t(chunks), Array(std::size_t(nv), 0));  // count, then next place
-    tbb::parallel_for(0, chunks, [&](int c) {
-      for (int k = chunk_begin(c); k < chunk_begin(c + 1); ++k) ++at[std::size_t(c)][std::size_t(from(k))];
-    });
-    for (int v = 0; v < nv; ++v) {
-      int place = first_out[std::size_t(v)];
-      for (auto& counts : at) place += std::exchange(counts[std::size_t(v)], place);
-      first_out[std::size_t(v) + 1] = place;
+  // The places, by blocks of vertices: each block's total, then each vertex's from its block's start.
+  const int blocks = (nv + kGrain - 1) / kGrain;
+  Array<int> block_first(std::size_t(blocks) + 1, 0);
+  tbb::parallel_for(0, blocks, [&](int b) {
+    int total = 0;
+    for (int v = b * kGrain; v < std::min(nv, (b + 1) * kGrain); ++v)
+      for (const auto& count : at) total += count[std::size_t(v)];
+    block_first[std::size_t(b) + 1] = total;
+  });
+  for (int b = 0; b < blocks; ++b) block_first[std::size_t(b) + 1] += block_first[std::size_t(b)];
+  tbb::parallel_for(0, blocks, [&](int b) {
+    int place = block_first[std::size_t(b)];
+    for (int v = b * kGrain; v < std::min(nv, (b + 1) * kGrain); ++v) {
+      s.first[std::size_t(v)] = place;
+      for (auto& count : at) place += std::exchange(count[std::size_t(v)], place);
     }
-    tbb::parallel_for(0, chunks, [&](int c) {
-      Array& next = at[std::size_t(c)];
-      for (int k = chunk_begin(c); k < chunk_begin(c + 1); ++k) {
-        const auto i = std::size_t(next[std::size_t(from(k))]++);
-        out[i] = k;
-        out_to[i] = to[std::size_t(k)];
-      }
-    });
+  });
+  s.first[std::size_t(nv)] = nk;
+  tbb::parallel_for(0, chunks, [&](int c) {
+    int* next = at[std::size_t(c)].data();
+    Side* out = s.sides.data();
+    for (int t = chunk_begin(c); t < chunk_begin(c + 1); ++t) {
+      const int a = corner(t, 0), b = corner(t, 1), o = corner(t, 2);
+      out[next[a]++] = {3 * t, b, o};
+      out[next[b]++] = {3 * t + 1, o, a};
+      out[next[o]++] = {3 * t + 2, a, b};
+    }
+  });
+  return s;
+}
+
+/// Whether a vertex's sides, each followed by the one to its opposite corner, make one fan: a
+/// cycle of three or more sides, or a single chain. The sides are `side[0, n)`; `next[i]` is set to
+/// the side after side i, or -1. Returns the index of the chain's last side (the side into the
+/// vertex of its triangle has no twin: the vertex is on the boundary), n for a cycle, or -1 when the
+/// sides are not one fan.
+/// An edge used twice in one direction, a→b by triangles (a, b, c) and (a, b, d), leaves vertex b
+/// two sides to c and d that the same side b→a follows, or none: not one fan at b.
+int one_fan(const Side* side, int n, int* next) {
+  for (int i = 0; i < n; ++i) {
+    int after = 0;
+    while (after < n && side[after].to != side[i].opposite) ++after;
+    next[i] = after < n ? after : -1;
   }
-  // The checks below run in parallel over the vertices; any one failing fails the whole.
+  // A chain starts at a side that follows none (there is one: n sides, at most n - 1 followed;
+  // a side two others lead to leaves the walk below short of n or looping past it).
+  int ends = 0, start = 0;
+  for (int i = 0; i < n; ++i) ends += next[i] < 0;
+  if (ends > 1) return -1;
+  if (ends == 1)
+    while (std::find(next, next + n, start) != next + n) ++start;
+  // Walk from the start: a chain or a cycle through all n sides is one fan.
+  int reached = 1, last = start;
+  for (int i = next[start]; i >= 0 && i != start; i = next[i]) {
+    if (++reached > n) return -1;
+    last = i;
+  }
+  if (reached != n) return -1;
+  if (ends == 1) return last;
+  return n >= 3 ? n : -1;  // two sides followed by each other: a triangle repeated the other way round
+}
+
+constexpr int kIsolated = std::numeric_limits<int>::max();
+
+/// Around each vertex a: its sides one fan (which also refuses an edge used twice in one direction
+/// or by three triangles, and a triangle repeated either way round), the side its halfedge comes
+/// from, and twins. Side a→b of triangle (a, b, c) is followed by side a→c, the twin of the
+/// triangle's side c→a: each pair is found once, from the smaller of a and c, which writes both
+/// sides of it. Nothing is read but a's own sides.
+/// vertex_side[v]: v's side in its last triangle (an inner vertex), ~k for a boundary vertex whose
+/// boundary halfedge is side k the other way round, or kIsolated. False when any vertex is not one
+/// fan.
+bool pair_twins_around_vertices(const SidesByVertex& s, Array<int>& twin, Array<int>& vertex_side) {
+  const int nv = int(vertex_side.size());
   std::atomic<bool> manifold = true;
-  auto over_vertices = [&](auto&& visit) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, nv, kGrain), [&](const tbb::blocked_range<int>& r) {
-      for (int v = r.begin(); v < r.end() && manifold.load(std::memory_order_relaxed); ++v)
-        if (!visit(v)) manifold = false;
-    });
-  };
-
-  // Twins, each pair found once, from its smaller vertex a (which alone writes both sides of it);
-  // a side used twice in one direction, or a triangle repeated the other way round, is not a
-  // manifold surface.
-  Array twin(std::size_t(nk), -1);
-  over_vertices([&](int a) {
-    const int end_a = first_out[std::size_t(a) + 1];
-    for (int i = first_out[std::size_t(a)]; i < end_a; ++i) {
-      const int k = out[std::size_t(i)], b = out_to[std::size_t(i)];
-      for (int i2 = i + 1; i2 < end_a; ++i2)
-        if (out_to[std::size_t(i2)] == b) return false;
-      if (b < a) continue;
-      for (int j_at = first_out[std::size_t(b)]; j_at < first_out[std::size_t(b) + 1]; ++j_at) {
-        if (out_to[std::size_t(j_at)] != a) continue;
-        const int j = out[std::size_t(j_at)];
-        if (from(previous_in_triangle(k)) == from(previous_in_triangle(j))) return false;
-        twin[std::size_t(k)] = j;
-        twin[std::size_t(j)] = k;
-      }
-    }
-    return true;
-  });
-  if (!manifold) return false;
-
-  // Each vertex's triangles one fan: turning around it from one of its sides reaches all of them.
-  over_vertices([&](int v) {
-    const int degree = first_out[std::size_t(v) + 1] - first_out[std::size_t(v)];
-    if (degree == 0) return true;
-    const int start = out[std::size_t(first_out[std::size_t(v)])];
-    int reached = 1;
-    bool open = false;
-    for (int k = start;;) {
-      const int t = twin[std::size_t(k)];
-      if (t < 0) {
-        open = true;
+  in_blocks(nv, [&](int begin, int end) {
+    std::vector<int> next;
+    for (int a = begin; a < end && manifold.load(std::memory_order_relaxed); ++a) {
+      const Side* around = s.sides.data() + s.first[std::size_t(a)];
+      const int n = s.first[std::size_t(a) + 1] - s.first[std::size_t(a)];
+      if (n == 0) continue;
+      if (next.size() < std::size_t(n)) next.resize(std::size_t(n));
+      const int last = one_fan(around, n, next.data());
+      if (last < 0) {
+        manifold = false;
         break;
       }
-      k = next_in_triangle(t);
-      if (k == start) break;
-      if (++reached > degree) return false;
+      vertex_side[std::size_t(a)] = last == n ? around[n - 1].k : ~previous_in_triangle(around[last].k);
+      for (int i = 0; i < n; ++i)
+        if (next[std::size_t(i)] >= 0 && a < around[i].opposite) {
+          const int into = previous_in_triangle(around[i].k), out = around[next[std::size_t(i)]].k;
+          twin[std::size_t(into)] = out;
+          twin[std::size_t(out)] = into;
+        }
     }
-    if (open)
-      for (int k = start;;) {
-        const int t = twin[std::size_t(previous_in_triangle(k))];
-        if (t < 0) break;
-        k = t;
-        if (++reached > degree) return false;
-      }
-    return reached == degree;
   });
-  if (!manifold) return false;
+  return manifold;
+}
 
-  // Edges numbered as add_face creates them: at a side's first use, in triangle then corner order,
-  // the edge's first halfedge along that side.
-  // The sides that make an edge are counted by blocks, then numbered from their block's first
-  // number; the others take their twin's edge, the other way round.
-  Array halfedge(static_cast<std::size_t>(nk), 0);
+/// Edges numbered as add_face creates them: at a side's first use, in triangle then corner order,
+/// the edge's first halfedge along that side. A side makes an edge when its twin, if any, comes
+/// after it: counted by blocks of sides, then numbered from their block's first number, their
+/// twins given the same edge the other way round.
+struct Numbering {
+  Array<int> halfedge;  // by side
+  int edges = 0;
+};
+Numbering number_halfedges(const Array<int>& twin) {
+  const int nk = int(twin.size());
   auto makes_edge = [&](int k) {
     const int t = twin[std::size_t(k)];
     return t < 0 || t > k;
   };
   const int blocks = (nk + kGrain - 1) / kGrain;
-  Array first_edge(std::size_t(blocks) + 1, 0);
+  Array<int> first_edge(std::size_t(blocks) + 1, 0);
   tbb::parallel_for(0, blocks, [&](int b) {
     int count = 0;
     for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k) count += makes_edge(k);
     first_edge[std::size_t(b) + 1] = count;
   });
   for (int b = 0; b < blocks; ++b) first_edge[std::size_t(b) + 1] += first_edge[std::size_t(b)];
-  const int ne = first_edge[std::size_t(blocks)];
+  Numbering numbering{Array<int>(std::size_t(nk)), first_edge[std::size_t(blocks)]};  // each side's written below
+  Array<int>& halfedge = numbering.halfedge;
   tbb::parallel_for(0, blocks, [&](int b) {
     int edge = first_edge[std::size_t(b)];
     for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k)
-      if (makes_edge(k)) halfedge[std::size_t(k)] = 2 * edge++;
-  });
-  tbb::parallel_for(0, blocks, [&](int b) {
-    for (int k = b * kGrain; k < std::min(nk, (b + 1) * kGrain); ++k)
-      if (!makes_edge(k)) halfedge[std::size_t(k)] = halfedge[std::size_t(twin[std::size_t(k)])] ^ 1;
-  });
-
-  mesh.resize(std::size_t(nv), std::size_t(ne), corners.size());
-  // Every write below is to an element of its own (a vertex has at most one boundary side leaving
-  // it, the fan check made sure).
-  Array boundary_out(std::size_t(nv), -1);
-  tbb::parallel_for(tbb::blocked_range<int>(0, nk, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int k = r.begin(); k < r.end(); ++k) {
-      const HalfedgeHandle h(halfedge[std::size_t(k)]);
-      mesh.set_vertex_handle(h, VertexHandle(to[std::size_t(k)]));
-      mesh.set_face_handle(h, FaceHandle(k / 3));
-      mesh.set_next_halfedge_handle(h, HalfedgeHandle(halfedge[std::size_t(next_in_triangle(k))]));
-      if (k % 3 == 2) mesh.set_halfedge_handle(FaceHandle(k / 3), h);
-      if (twin[std::size_t(k)] < 0) {
-        const HalfedgeHandle b(halfedge[std::size_t(k)] ^ 1);
-        mesh.set_vertex_handle(b, VertexHandle(from(k)));
-        mesh.set_face_handle(b, FaceHandle());
-        boundary_out[std::size_t(to[std::size_t(k)])] = b.idx();
+      if (makes_edge(k)) {
+        halfedge[std::size_t(k)] = 2 * edge;
+        if (const int t = twin[std::size_t(k)]; t >= 0) halfedge[std::size_t(t)] = 2 * edge + 1;
+        ++edge;
       }
+  });
+  return numbering;
+}
+
+}  // namespace
+
+bool build_connectivity(SurfaceMesh& mesh, Corners corners) {
+  const int nv = int(mesh.n_vertices());
+  const int nt = int(corners.size()), nk = 3 * nt;
+  auto from = [&](int k) { return int(corners[std::size_t(k / 3)][std::size_t(k % 3)]); };
+
+  Array<int> twin(std::size_t(nk), -1), vertex_side(std::size_t(nv), kIsolated);
+  if (!pair_twins_around_vertices(sides_by_vertex(corners, nv), twin, vertex_side)) return false;
+  // (The sides are freed: what follows reuses their memory rather than fresh pages.)
+  const Numbering numbering = number_halfedges(twin);
+  auto halfedge = [&](int k) { return HalfedgeHandle(numbering.halfedge[std::size_t(k)]); };
+  auto opposite = [](HalfedgeHandle h) { return HalfedgeHandle(h.idx() ^ 1); };
+  auto vertex_halfedge = [&](int v) {
+    const int s = vertex_side[std::size_t(v)];
+    return s >= 0 ? halfedge(s) : opposite(halfedge(~s));
+  };
+
+  mesh.resize(std::size_t(nv), std::size_t(numbering.edges), corners.size());
+  // Every write below is to an element of its own: a halfedge's `next` sets its next one's `prev`,
+  // and a vertex has at most one boundary halfedge leaving it (one fan).
+  in_blocks(nt, [&](int begin, int end) {
+    for (int t = begin; t < end; ++t) {
+      const HalfedgeHandle h[3] = {halfedge(3 * t), halfedge(3 * t + 1), halfedge(3 * t + 2)};
+      for (int i = 0; i < 3; ++i) {
+        const int k = 3 * t + i;
+        mesh.set_vertex_handle(h[i], VertexHandle(from(next_in_triangle(k))));
+        mesh.set_face_handle(h[i], FaceHandle(t));
+        mesh.set_next_halfedge_handle(h[i], h[(i + 1) % 3]);
+        if (twin[std::size_t(k)] < 0) {
+          // The boundary halfedge the other way round, and the boundary halfedge leaving its end.
+          const HalfedgeHandle b = opposite(h[i]);
+          mesh.set_vertex_handle(b, VertexHandle(from(k)));
+          mesh.set_face_handle(b, FaceHandle());
+          mesh.set_next_halfedge_handle(b, vertex_halfedge(from(k)));
+        }
+      }
+      mesh.set_halfedge_handle(FaceHandle(t), h[2]);
     }
   });
-  // A boundary halfedge ends where the next one leaves (one per vertex: each vertex is one fan).
-  tbb::parallel_for(tbb::blocked_range<int>(0, nk, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int k = r.begin(); k < r.end(); ++k)
-      if (twin[std::size_t(k)] < 0)
-        mesh.set_next_halfedge_handle(HalfedgeHandle(halfedge[std::size_t(k)] ^ 1),
-                                      HalfedgeHandle(boundary_out[std::size_t(from(k))]));
-  });
-  tbb::parallel_for(tbb::blocked_range<int>(0, nv, kGrain), [&](const tbb::blocked_range<int>& r) {
-    for (int v = r.begin(); v < r.end(); ++v) {
-      const int last = first_out[std::size_t(v) + 1];
-      if (boundary_out[std::size_t(v)] >= 0)
-        mesh.set_halfedge_handle(VertexHandle(v), HalfedgeHandle(boundary_out[std::size_t(v)]));
-      else if (last > first_out[std::size_t(v)])
-        mesh.set_halfedge_handle(VertexHandle(v), HalfedgeHandle(halfedge[std::size_t(out[std::size_t(last - 1)])]));
-    }
+  in_blocks(nv, [&](int begin, int end) {
+    for (int v = begin; v < end; ++v)
+      if (vertex_side[std::size_t(v)] != kIsolated) mesh.set_halfedge_handle(VertexHandle(v), vertex_halfedge(v));
   });
   return true;
 }
