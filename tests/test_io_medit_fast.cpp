@@ -19,6 +19,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <sstream>
 #include <string>
@@ -367,6 +368,71 @@ TEST_CASE(".meshb and .solb built byte by byte: versions 1 to 4, both byte order
       CHECK(fields[1].values == std::vector<double>{0.25, 0.5, 0.75, 0.5, 1, 1.5, 0.75, 1.5, 2.25});
       CHECK(read_scalar_sol(dir / "fields.solb", 3) == ScalarField{-1, -0.5, 0});
     }
+}
+
+TEST_CASE("a large .meshb is parsed by both threads: the same mesh, in both byte orders, and the first bad record's error") {
+  // 40k triangles and 20k vertices: records in several chunks. Version 4 (64-bit integers, whose
+  // refs can be out of an int's range), built byte by byte.
+  TempDir dir("io-fast-meshb-chunks");
+  const SurfaceMesh sphere = make_sphere({.faces = 40000});
+  const auto corners = [&] {
+    std::vector<std::array<int, 3>> c;
+    for (auto f : sphere.faces()) {
+      std::array<int, 3> t{};
+      int k = 0;
+      for (auto v : sphere.fv_range(f)) t[std::size_t(k++)] = v.idx();
+      c.push_back(t);
+    }
+    return c;
+  }();
+  auto meshb = [&](bool big_endian, std::map<std::size_t, std::int64_t> vertex_refs,
+                   std::map<std::size_t, std::int64_t> triangle_refs) {
+    Gmf g = Gmf::file(4, big_endian);
+    Gmf b = g.body();
+    b.word(3);
+    g.keyword(3, b);
+    b = g.body();
+    b.integer(std::int64_t(sphere.n_vertices()));
+    for (auto v : sphere.vertices()) {
+      for (int k = 0; k < 3; ++k) b.real(sphere.point(v)[k]);
+      b.integer(vertex_refs.count(std::size_t(v.idx())) ? vertex_refs[std::size_t(v.idx())] : v.idx() % 7);
+    }
+    g.keyword(4, b);
+    b = g.body();
+    b.integer(std::int64_t(corners.size()));
+    for (std::size_t t = 0; t < corners.size(); ++t) {
+      for (int v : corners[t]) b.integer(v + 1);
+      b.integer(triangle_refs.count(t) ? triangle_refs[t] : std::int64_t(t % 2 ? kInside : kOutside));
+    }
+    g.keyword(6, b);
+    g.end();
+    return g.bytes;
+  };
+  for (bool big_endian : {false, true}) {
+    write_bytes(dir / "a.meshb", meshb(big_endian, {}, {}));
+    const SurfaceMesh back = read_mesh(dir / "a.meshb");
+    REQUIRE(back.n_vertices() == sphere.n_vertices());
+    REQUIRE(back.n_faces() == sphere.n_faces());
+    std::size_t differences = 0;
+    for (auto v : sphere.vertices())
+      differences += back.point(v) != sphere.point(v) || back.vertex_ref(v) != v.idx() % 7;
+    for (auto f : back.faces()) {
+      std::array<int, 3> t{};
+      int k = 0;
+      for (auto v : back.fv_range(f)) t[std::size_t(k++)] = v.idx();
+      differences += t != corners[std::size_t(f.idx())] || back.region(f) != (f.idx() % 2 ? kInside : kOutside);
+    }
+    CHECK(differences == 0);
+  }
+  // Refs beyond 32 bits in two chunks: the earlier record's is named, as one loop would.
+  const std::int64_t wide = (std::int64_t(1) << 32) + 3, wider = -(std::int64_t(1) << 33);
+  write_bytes(dir / "b.meshb", meshb(false, {}, {{35000, wider}, {20000, wide}}));
+  std::string message = error_of([&] { read_mesh(dir / "b.meshb"); });
+  INFO(message);
+  CHECK(message.find("a triangle ref 4294967299 does not fit in 32 bits") != std::string::npos);
+  write_bytes(dir / "b.meshb", meshb(false, {{18000, wide}, {3000, wider}}, {}));
+  message = error_of([&] { read_mesh(dir / "b.meshb"); });
+  CHECK(message.find("a vertex ref -8589934592 does not fit in 32 bits") != std::string::npos);
 }
 
 TEST_CASE("truncated or corrupt .meshb/.solb: an InputError naming the file, never a crash or a huge allocation") {

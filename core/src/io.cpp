@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -23,6 +24,7 @@
 #include <limits>
 #include <memory>
 #include <new>
+#include <vector>
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -63,21 +65,38 @@ FileBytes::FileBytes(const std::filesystem::path& file) {
     return file_error(file, fmt::format("read error ({})", std::strerror(error)));
   };
   if (stated && S_ISREG(st.st_mode) && std::size_t(st.st_size) >= kBulkThreshold) {
-    // A big regular file: one read into huge-page memory (bulk_allocate).
+    // A big regular file: read into huge-page memory (bulk_allocate) by pieces, one per thread:
+    // the kernel's copy from the page cache is most of the time a read takes, and runs on each.
     capacity_ = std::size_t(st.st_size);
     data_ = static_cast<char*>(bulk_allocate(capacity_));
-    while (size_ < capacity_) {
-      const ssize_t got = ::read(fd, data_ + size_, capacity_ - size_);
-      if (got == 0) break;  // shrunk meanwhile: what there is
-      if (got < 0) {
-        if (errno == EINTR) continue;
-        const int error = errno;
+    const int pieces = std::clamp(int(capacity_ / kBulkThreshold), 1, tbb::this_task_arena::max_concurrency());
+    auto piece_begin = [&](int i) {  // on a page
+      return i == pieces ? capacity_ : capacity_ * std::size_t(i) / std::size_t(pieces) / 4096 * 4096;
+    };
+    std::vector<std::size_t> got(std::size_t(pieces), 0);
+    std::vector<int> error(std::size_t(pieces), 0);
+    tbb::parallel_for(0, pieces, [&](int i) {
+      const std::size_t begin = piece_begin(i), end = piece_begin(i + 1);
+      std::size_t& done = got[std::size_t(i)];
+      while (begin + done < end) {
+        const ssize_t n = ::pread(fd, data_ + begin + done, end - begin - done, off_t(begin + done));
+        if (n == 0) break;  // shrunk meanwhile
+        if (n < 0) {
+          if (errno == EINTR) continue;
+          error[std::size_t(i)] = errno;
+          break;
+        }
+        done += std::size_t(n);
+      }
+    });
+    for (const int e : error)
+      if (e) {
         bulk_free(data_, capacity_);
         data_ = nullptr;
-        throw fail(error);
+        throw fail(e);
       }
-      size_ += std::size_t(got);
-    }
+    // What there is from the start: less than the size when the file shrank meanwhile.
+    for (int i = 0; i < pieces && size_ == piece_begin(i); ++i) size_ += got[std::size_t(i)];
     ::close(fd);
     return;
   }
@@ -110,12 +129,17 @@ FileBytes::~FileBytes() {
 }
 
 void* bulk_allocate(std::size_t bytes) {
-  // Aligned on 2 MiB and a multiple of it (aligned_alloc's rule), so every page of the block can
-  // be huge. From malloc: a process that already freed such blocks gets them back, faulted in.
-  const std::size_t size = (bytes + kBulkThreshold - 1) / kBulkThreshold * kBulkThreshold;
-  void* p = std::aligned_alloc(kBulkThreshold, size);
+  // From malloc, not aligned_alloc: the ends aligned_alloc splits off are taken by small blocks,
+  // and pinned between them the freed big blocks no longer fit the next read's, which grows the
+  // heap into fresh pages every time. A process that already freed such blocks gets them back,
+  // faulted in. The block's whole 2 MiB pages are asked to be huge (a hint; a heap on huge pages,
+  // glibc.malloc.hugetlb=1, already is).
+  void* p = std::malloc(bytes);
   if (!p) throw std::bad_alloc();
-  ::madvise(p, size, MADV_HUGEPAGE);  // a hint: no huge pages is fine too
+  const auto at = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t begin = (at + kBulkThreshold - 1) / kBulkThreshold * kBulkThreshold;
+  const std::uintptr_t end = (at + bytes) / kBulkThreshold * kBulkThreshold;
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
   return p;
 }
 
@@ -278,9 +302,11 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     return 0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
   };
   // The sides' total length (by fixed blocks: the same for any number of threads) and the least
-  // area in one sweep; the first triangle too small is looked for only when the least one is.
+  // area in one sweep; the first triangle too small is looked for only when the least one is. The
+  // least area is taken of the squared cross products, one square root in all (the same number:
+  // a square root never reorders).
   struct Scale {
-    double length = 0, least_area = std::numeric_limits<double>::infinity();
+    double length = 0, least_cross2 = std::numeric_limits<double>::infinity();
   };
   const Scale scale = reduce(
       nt, Scale{},
@@ -288,15 +314,17 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
         const auto& tri = r.triangles[std::size_t(t)];
         const Vec3 &a = r.points[std::size_t(tri[0])], &b = r.points[std::size_t(tri[1])], &c = r.points[std::size_t(tri[2])];
         s.length += (b - a).norm() + (c - b).norm() + (a - c).norm();
-        if (const double at = area(t); !(at >= s.least_area)) s.least_area = at;  // a NaN too
+        if (const double cross2 = OpenMesh::cross(b - a, c - a).sqrnorm(); !(cross2 >= s.least_cross2))
+          s.least_cross2 = cross2;  // a NaN too
       },
       [](Scale& total, const Scale& s) {
         total.length += s.length;
-        if (!(s.least_area >= total.least_area)) total.least_area = s.least_area;
+        if (!(s.least_cross2 >= total.least_cross2)) total.least_cross2 = s.least_cross2;
       });
+  const double least_area = 0.5 * std::sqrt(scale.least_cross2);
   const double mean_length = scale.length / (3.0 * double(nt));
   const double min_area = options.min_relative_area * mean_length * mean_length;
-  const int flat = scale.least_area > min_area ? nt : first_where(nt, [&](int t) { return !(area(t) > min_area); });
+  const int flat = least_area > min_area ? nt : first_where(nt, [&](int t) { return !(area(t) > min_area); });
   if (flat < nt)
     throw r.triangle_at.error(file, std::size_t(flat),
                               fmt::format("triangle {} has zero area ({:.3g}, below {:.3g} x mean edge length^2)",

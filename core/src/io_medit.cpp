@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <string_view>
 
@@ -185,24 +186,47 @@ MeshRecords read_medit_text(std::string_view text, const fs::path& file) {
   return r;
 }
 
+/// Records [0, n) of `size` bytes each from `in`'s position, on both threads:
+/// read(scanner at record `begin`, begin, end) by chunks of records. The first record that throws
+/// throws, as a loop would; `in` is left after the last record.
+template <class Read>
+void read_records(BinaryScanner& in, std::int64_t n, std::size_t size, Read&& read) {
+  constexpr std::int64_t kChunk = 16384;
+  const std::size_t start = in.pos();
+  const std::int64_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::exception_ptr> failed(std::size_t(chunks), nullptr);
+  tbb::parallel_for(std::int64_t(0), chunks, [&](std::int64_t c) {
+    BinaryScanner at = in;
+    at.seek(start + std::size_t(c * kChunk) * size);
+    try {
+      read(at, c * kChunk, std::min(n, (c + 1) * kChunk));
+    } catch (...) {
+      failed[std::size_t(c)] = std::current_exception();
+    }
+  });
+  for (const auto& error : failed)
+    if (error) std::rethrow_exception(error);
+  in.seek(start + std::size_t(n) * size);
+}
+
 MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   BinaryScanner in(bytes, file);
   const BinaryFormat format = read_binary_header(in);
   MeshRecords r;
   int dimension = 3;
-  auto read_index = [&]() -> std::int64_t {
-    return format.int64_integers() ? in.get_unchecked<std::int64_t>() : std::int64_t(in.get_unchecked<std::int32_t>());
+  auto read_index = [&](BinaryScanner& at) -> std::int64_t {
+    return format.int64_integers() ? at.get_unchecked<std::int64_t>() : std::int64_t(at.get_unchecked<std::int32_t>());
   };
   // A ref of a 64-bit file must still fit an int.
-  auto read_ref = [&](const char* what) -> int {
-    const std::int64_t value = read_index();
+  auto read_ref = [&](BinaryScanner& at, const char* what) -> int {
+    const std::int64_t value = read_index(at);
     if (value < std::numeric_limits<int>::min() || value > std::numeric_limits<int>::max())
       throw file_error(file, fmt::format("{} {} does not fit in 32 bits (refs are from {} to {})", what, value,
                                          std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
     return int(value);
   };
-  auto read_real = [&]() -> double {
-    return format.float32() ? double(in.get_unchecked<float>()) : in.get_unchecked<double>();
+  auto read_real = [&](BinaryScanner& at) -> double {
+    return format.float32() ? double(at.get_unchecked<float>()) : at.get_unchecked<double>();
   };
   auto records = [&](const char* section, std::size_t record_size) {
     auto n = read_count(in, format, section);
@@ -212,7 +236,7 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   auto index_list = [&](const char* section, BulkVector<std::int64_t>& items, Locator& at) {
     auto n = records(section, format.int_size());
     at = Locator::bytes(in.pos(), format.int_size());
-    for (std::int64_t i = 0; i < n; ++i) items.push_back(zero_based(read_index()));
+    for (std::int64_t i = 0; i < n; ++i) items.push_back(zero_based(read_index(in)));
   };
   walk_binary_keywords(in, format, [&](int code, std::size_t start) {
     switch (code) {
@@ -225,12 +249,14 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         r.vertex_at = Locator::bytes(in.pos(), size);
         r.points.resize(std::size_t(n));
         r.vertex_refs.resize(std::size_t(n));
-        for (std::int64_t i = 0; i < n; ++i) {
-          Vec3 p(0, 0, 0);
-          for (int k = 0; k < dimension; ++k) p[k] = read_real();
-          r.points[std::size_t(i)] = p;
-          r.vertex_refs[std::size_t(i)] = read_ref("a vertex ref");
-        }
+        read_records(in, n, size, [&](BinaryScanner& at, std::int64_t begin, std::int64_t end) {
+          for (auto i = std::size_t(begin); i < std::size_t(end); ++i) {
+            Vec3 p(0, 0, 0);
+            for (int k = 0; k < dimension; ++k) p[k] = read_real(at);
+            r.points[i] = p;
+            r.vertex_refs[i] = read_ref(at, "a vertex ref");
+          }
+        });
         break;
       }
       case kTriangles: {
@@ -239,11 +265,12 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         r.triangle_at = Locator::bytes(in.pos(), size);
         r.triangles.resize(std::size_t(n));
         r.triangle_refs.resize(std::size_t(n));
-        for (std::int64_t i = 0; i < n; ++i) {
-          auto& t = r.triangles[std::size_t(i)];
-          for (auto& v : t) v = zero_based(read_index());
-          r.triangle_refs[std::size_t(i)] = read_ref("a triangle ref");
-        }
+        read_records(in, n, size, [&](BinaryScanner& at, std::int64_t begin, std::int64_t end) {
+          for (auto i = std::size_t(begin); i < std::size_t(end); ++i) {
+            for (auto& v : r.triangles[i]) v = zero_based(read_index(at));
+            r.triangle_refs[i] = read_ref(at, "a triangle ref");
+          }
+        });
         break;
       }
       case kEdges: {
@@ -254,8 +281,8 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
         r.edge_refs.resize(std::size_t(n));
         for (std::int64_t i = 0; i < n; ++i) {
           auto& e = r.edges[std::size_t(i)];
-          for (auto& v : e) v = zero_based(read_index());
-          r.edge_refs[std::size_t(i)] = read_ref("an edge ref");
+          for (auto& v : e) v = zero_based(read_index(in));
+          r.edge_refs[std::size_t(i)] = read_ref(in, "an edge ref");
         }
         break;
       }
@@ -428,8 +455,12 @@ MeshRecords parse_medit(std::string_view bytes, const fs::path& file) {
 }
 
 SurfaceMesh read_medit(const fs::path& file, const ReadOptions& options) {
-  const FileBytes bytes(file);
-  return build_mesh(parse_medit(bytes.view(), file), file, options);
+  MeshRecords records;
+  {
+    const FileBytes bytes(file);
+    records = parse_medit(bytes.view(), file);
+  }  // the file's bytes freed: the build reuses their memory rather than fresh pages
+  return build_mesh(std::move(records), file, options);
 }
 
 void write_medit(const SurfaceMesh& mesh, const fs::path& file, bool binary) {
