@@ -4,7 +4,8 @@
 //
 // Each operation is timed R times (default 5) and its median printed in ms and MB/s (file bytes
 // per second), then written as CSV (format,operation,faces,seconds,bytes,mb_per_s). For Medit
-// files, besides `read` (parse + validated build of the mesh, in this warm process) and `write`:
+// files, besides `read` (parse + validated build of the mesh, in this warm process, whose heap
+// keeps freed blocks as every bodyfit process does) and `write`:
 //   parse   the parse alone (the records, before the mesh is built);
 //   cold    a read in a fresh process, as `bodyfit <command> in.mesh` does it: restarted once
 //           with its heap on transparent huge pages and freed blocks kept, as the commands are,
@@ -116,9 +117,9 @@ double cold_read(const fs::path& file) {
 
 int main(int argc, char** argv) {
   const Arguments args = parse_arguments(argc, argv);
+  keep_freed_blocks();  // as every bodyfit process does from its start
   if (!args.read_once.empty()) {
     restart_on_huge_pages(argv);  // the heap as the stage commands have it
-    keep_freed_blocks();
     const double s = seconds_of([&] { (void)read_mesh(args.read_once); });
     std::printf("%.9f\n", s);
     return 0;
