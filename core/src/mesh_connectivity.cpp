@@ -131,7 +131,8 @@ constexpr int kIsolated = std::numeric_limits<int>::max();
 /// or by three triangles, and a triangle repeated either way round), the side its halfedge comes
 /// from, and twins. Side a→b of triangle (a, b, c) is followed by side a→c, the twin of the
 /// triangle's side c→a: each pair is found once, from the smaller of a and c, which writes both
-/// sides of it. Nothing is read but a's own sides.
+/// sides of it; a side into a that no side follows has none (-1). Every side is into one vertex,
+/// so every twin is written, and nothing is read but a's own sides.
 /// vertex_side[v]: v's side in its last triangle (an inner vertex), ~k for a boundary vertex whose
 /// boundary halfedge is side k the other way round, or kIsolated. False when any vertex is not one
 /// fan.
@@ -143,7 +144,10 @@ bool pair_twins_around_vertices(const SidesByVertex& s, Array<int>& twin, Array<
     for (int a = begin; a < end && manifold.load(std::memory_order_relaxed); ++a) {
       const Side* around = s.sides.data() + s.first[std::size_t(a)];
       const int n = s.first[std::size_t(a) + 1] - s.first[std::size_t(a)];
-      if (n == 0) continue;
+      if (n == 0) {
+        vertex_side[std::size_t(a)] = kIsolated;
+        continue;
+      }
       if (next.size() < std::size_t(n)) next.resize(std::size_t(n));
       const int last = one_fan(around, n, next.data());
       if (last < 0) {
@@ -151,12 +155,16 @@ bool pair_twins_around_vertices(const SidesByVertex& s, Array<int>& twin, Array<
         break;
       }
       vertex_side[std::size_t(a)] = last == n ? around[n - 1].k : ~previous_in_triangle(around[last].k);
-      for (int i = 0; i < n; ++i)
-        if (next[std::size_t(i)] >= 0 && a < around[i].opposite) {
-          const int into = previous_in_triangle(around[i].k), out = around[next[std::size_t(i)]].k;
+      for (int i = 0; i < n; ++i) {
+        const int into = previous_in_triangle(around[i].k);
+        if (next[std::size_t(i)] < 0) {
+          twin[std::size_t(into)] = -1;  // a boundary side
+        } else if (a < around[i].opposite) {
+          const int out = around[next[std::size_t(i)]].k;
           twin[std::size_t(into)] = out;
           twin[std::size_t(out)] = into;
         }
+      }
     }
   });
   return manifold;
@@ -205,7 +213,7 @@ bool build_connectivity(SurfaceMesh& mesh, Corners corners) {
   const int nt = int(corners.size()), nk = 3 * nt;
   auto from = [&](int k) { return int(corners[std::size_t(k / 3)][std::size_t(k % 3)]); };
 
-  Array<int> twin(std::size_t(nk), -1), vertex_side(std::size_t(nv), kIsolated);
+  Array<int> twin(static_cast<std::size_t>(nk)), vertex_side(static_cast<std::size_t>(nv));  // each written below
   if (!pair_twins_around_vertices(sides_by_vertex(corners, nv), twin, vertex_side)) return false;
   // (The sides are freed: what follows reuses their memory rather than fresh pages.)
   const Numbering numbering = number_halfedges(twin);
