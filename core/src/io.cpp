@@ -279,16 +279,41 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
                                        "malformed file",
                                        r.points.size()));
 
-  // Indices, degenerate triangles and the mesh scale.
+  // Indices, degenerate triangles and the mesh scale, in one sweep: the first bad triangle, and
+  // over the others the sides' total length (by fixed blocks: the same for any number of threads)
+  // and the least area, taken of the squared cross products (one square root in all, the same
+  // number: a square root never reorders). The first triangle too small is looked for only when
+  // the least one is.
   const int nt = int(r.triangles.size());
-  const int bad_triangle = first_where(nt, [&](int t) {
-    const auto& tri = r.triangles[std::size_t(t)];
+  auto bad = [&](const std::array<std::int64_t, 3>& tri) {
     for (auto i : tri)
       if (i < 0 || i >= nv) return true;
     return tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
-  });
-  if (bad_triangle < nt) {
-    const auto t = std::size_t(bad_triangle);
+  };
+  struct Scale {
+    int first_bad = std::numeric_limits<int>::max();
+    double length = 0, least_cross2 = std::numeric_limits<double>::infinity();
+  };
+  const Scale scale = reduce(
+      nt, Scale{},
+      [&](int t, Scale& s) {
+        const auto& tri = r.triangles[std::size_t(t)];
+        if (bad(tri)) {
+          s.first_bad = std::min(s.first_bad, t);
+          return;
+        }
+        const Vec3 &a = r.points[std::size_t(tri[0])], &b = r.points[std::size_t(tri[1])], &c = r.points[std::size_t(tri[2])];
+        s.length += (b - a).norm() + (c - b).norm() + (a - c).norm();
+        if (const double cross2 = OpenMesh::cross(b - a, c - a).sqrnorm(); !(cross2 >= s.least_cross2))
+          s.least_cross2 = cross2;  // a NaN too
+      },
+      [](Scale& total, const Scale& s) {
+        total.first_bad = std::min(total.first_bad, s.first_bad);
+        total.length += s.length;
+        if (!(s.least_cross2 >= total.least_cross2)) total.least_cross2 = s.least_cross2;
+      });
+  if (scale.first_bad < nt) {
+    const auto t = std::size_t(scale.first_bad);
     const auto& tri = r.triangles[t];
     for (auto i : tri)
       if (i < 0 || i >= nv)
@@ -301,26 +326,6 @@ SurfaceMesh build_mesh(MeshRecords&& r, const std::filesystem::path& file, const
     const auto& tri = r.triangles[std::size_t(t)];
     return 0.5 * OpenMesh::cross(r.points[tri[1]] - r.points[tri[0]], r.points[tri[2]] - r.points[tri[0]]).norm();
   };
-  // The sides' total length (by fixed blocks: the same for any number of threads) and the least
-  // area in one sweep; the first triangle too small is looked for only when the least one is. The
-  // least area is taken of the squared cross products, one square root in all (the same number:
-  // a square root never reorders).
-  struct Scale {
-    double length = 0, least_cross2 = std::numeric_limits<double>::infinity();
-  };
-  const Scale scale = reduce(
-      nt, Scale{},
-      [&](int t, Scale& s) {
-        const auto& tri = r.triangles[std::size_t(t)];
-        const Vec3 &a = r.points[std::size_t(tri[0])], &b = r.points[std::size_t(tri[1])], &c = r.points[std::size_t(tri[2])];
-        s.length += (b - a).norm() + (c - b).norm() + (a - c).norm();
-        if (const double cross2 = OpenMesh::cross(b - a, c - a).sqrnorm(); !(cross2 >= s.least_cross2))
-          s.least_cross2 = cross2;  // a NaN too
-      },
-      [](Scale& total, const Scale& s) {
-        total.length += s.length;
-        if (!(s.least_cross2 >= total.least_cross2)) total.least_cross2 = s.least_cross2;
-      });
   const double least_area = 0.5 * std::sqrt(scale.least_cross2);
   const double mean_length = scale.length / (3.0 * double(nt));
   const double min_area = options.min_relative_area * mean_length * mean_length;
