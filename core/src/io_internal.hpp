@@ -16,10 +16,10 @@
 
 namespace bodyfit::io_detail {
 
-/// Memory for the big buffers of a reader: at 2 MiB and above, aligned on 2 MiB with transparent
-/// huge pages requested (MADV_HUGEPAGE), so that filling a 6 MB array takes a few page faults
-/// instead of 1500 — on the machines measured a fault per 4 KiB page cost more than parsing that
-/// page, and a command reads its mesh into memory it never touched before.
+/// Memory for the big buffers of a reader: at 2 MiB and above, with transparent huge pages
+/// requested (MADV_HUGEPAGE) for the whole 2 MiB pages in it, so that filling a 6 MB array takes a
+/// few page faults instead of 1500 — on the machines measured a fault per 4 KiB page cost more than
+/// parsing that page, and a command reads its mesh into memory it never touched before.
 void* bulk_allocate(std::size_t bytes);
 void bulk_free(void* p, std::size_t bytes);
 inline constexpr std::size_t kBulkThreshold = std::size_t(2) << 20;
@@ -120,9 +120,9 @@ std::string extension_of(const std::filesystem::path& file);
 /// The whole file in memory; InputError when it cannot be opened or read.
 std::string read_file_bytes(const std::filesystem::path& file);
 
-/// The whole file in memory, read in one go into huge-page memory (bulk_allocate) when it is a
-/// big regular file: a 12 MB mesh then costs a few page faults instead of 3000, which cost more
-/// than parsing it. InputError when it cannot be opened or read.
+/// The whole file in memory, read by pieces on every thread into huge-page memory (bulk_allocate)
+/// when it is a big regular file: a 12 MB mesh then costs a few page faults instead of 3000, which
+/// cost more than parsing it. InputError when it cannot be opened or read.
 class FileBytes {
  public:
   explicit FileBytes(const std::filesystem::path& file);
