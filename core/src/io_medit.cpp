@@ -296,24 +296,6 @@ MeshRecords read_medit_binary(std::string_view bytes, const fs::path& file) {
   return r;
 }
 
-/// Calls visit(element) for each live vertex or face in index order, what mesh.vertices() and
-/// mesh.faces() give, as a plain loop: OpenMesh's skipping iterator is inlined or not as this
-/// file's other code leaves the compiler's budget, and called out of line it cost a third of a
-/// .meshb write.
-template <class Handle, class Visit>
-void for_each_live(const SurfaceMesh& mesh, std::size_t n, Visit&& visit) {
-  for (std::size_t i = 0; i < n; ++i)
-    if (const Handle h{int(i)}; !mesh.status(h).deleted()) visit(h);
-}
-template <class Visit>
-void for_each_vertex(const SurfaceMesh& mesh, Visit&& visit) {
-  for_each_live<VertexHandle>(mesh, mesh.n_vertices(), visit);
-}
-template <class Visit>
-void for_each_face(const SurfaceMesh& mesh, Visit&& visit) {
-  for_each_live<FaceHandle>(mesh, mesh.n_faces(), visit);
-}
-
 /// What a Medit writer writes besides the vertices and triangles: the edges MMG must keep, the
 /// lists of tags, and the vertices' numbers where deleted vertices leave gaps.
 struct MeditContent {

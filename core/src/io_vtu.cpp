@@ -76,8 +76,8 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
     throw file_error(file, fmt::format("write_vtu: expected a .vtu file name, got '{}'", io_detail::extension_of(file)));
   const auto index = io_detail::vertex_numbering(mesh);
   std::size_t n_points = 0, n_cells = 0;
-  for (auto v : mesh.vertices()) (void)v, ++n_points;
-  for (auto f : mesh.faces()) (void)f, ++n_cells;
+  io_detail::for_each_vertex(mesh, [&](VertexHandle) { ++n_points; });
+  io_detail::for_each_face(mesh, [&](FaceHandle) { ++n_cells; });
   const bool compact = n_points == mesh.n_vertices();
 
   auto check_size = [&](const std::string& name, std::size_t size, std::size_t expected, const char* what) {
@@ -94,10 +94,10 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
   auto point_scalar = [&](const std::string& name, auto value_of) {
     Block b{fmt::format(R"(type="Float64" Name="{}")", xml_escape(name)), {}};
     b.bytes.reserve(8 * n_points);
-    for (auto v : mesh.vertices()) {
-      double x = value_of(v);
+    io_detail::for_each_vertex(mesh, [&](VertexHandle v) {
+      const double x = value_of(v);
       append_raw(b.bytes, &x, 1);
-    }
+    });
     point_blocks.push_back(std::move(b));
   };
   point_scalar("phi", [&](VertexHandle v) { return mesh.phi(v); });
@@ -115,7 +115,7 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
   for (const auto& [name, values] : fields.point_vectors) {
     Block b{fmt::format(R"(type="Float64" Name="{}" NumberOfComponents="3")", xml_escape(name)), {}};
     b.bytes.reserve(24 * n_points);
-    for (auto v : mesh.vertices()) append_raw(b.bytes, values[std::size_t(v.idx())].data(), 3);
+    io_detail::for_each_vertex(mesh, [&](VertexHandle v) { append_raw(b.bytes, values[std::size_t(v.idx())].data(), 3); });
     point_blocks.push_back(std::move(b));
   }
   // Cell data: region, quality, then the caller's fields.
@@ -123,40 +123,40 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
     Block region{R"(type="Int32" Name="region")", {}}, quality{R"(type="Float64" Name="quality")", {}};
     region.bytes.reserve(4 * n_cells);
     quality.bytes.reserve(8 * n_cells);
-    for (auto f : mesh.faces()) {
-      std::int32_t r = mesh.region(f);
-      double q = face_quality(mesh, f);
+    io_detail::for_each_face(mesh, [&](FaceHandle f) {
+      const std::int32_t r = mesh.region(f);
+      const double q = face_quality(mesh, f);
       append_raw(region.bytes, &r, 1);
       append_raw(quality.bytes, &q, 1);
-    }
+    });
     cell_blocks.push_back(std::move(region));
     cell_blocks.push_back(std::move(quality));
   }
   for (const auto& [name, values] : fields.cell_scalars) {
     Block b{fmt::format(R"(type="Float64" Name="{}")", xml_escape(name)), {}};
     b.bytes.reserve(8 * n_cells);
-    for (auto f : mesh.faces()) append_raw(b.bytes, &values[std::size_t(f.idx())], 1);
+    io_detail::for_each_face(mesh, [&](FaceHandle f) { append_raw(b.bytes, &values[std::size_t(f.idx())], 1); });
     cell_blocks.push_back(std::move(b));
   }
   // Geometry: points, connectivity, offsets, types.
   {
     Block points{R"(type="Float64" Name="Points" NumberOfComponents="3")", {}};
     points.bytes.reserve(24 * n_points);
-    for (auto v : mesh.vertices()) append_raw(points.bytes, mesh.point(v).data(), 3);
+    io_detail::for_each_vertex(mesh, [&](VertexHandle v) { append_raw(points.bytes, mesh.point(v).data(), 3); });
     Block connectivity{R"(type="Int64" Name="connectivity")", {}};
     Block offsets{R"(type="Int64" Name="offsets")", {}};
     Block types{R"(type="UInt8" Name="types")", {}};
     connectivity.bytes.reserve(24 * n_cells);
     offsets.bytes.reserve(8 * n_cells);
     std::int64_t offset = 0;
-    for (auto f : mesh.faces()) {
+    io_detail::for_each_face(mesh, [&](FaceHandle f) {
       std::int64_t tri[3];
       int k = 0;
       for (auto v : mesh.fv_range(f)) tri[k++] = index[std::size_t(v.idx())];
       append_raw(connectivity.bytes, tri, 3);
       offset += 3;
       append_raw(offsets.bytes, &offset, 1);
-    }
+    });
     types.bytes.assign(n_cells, char(5));  // VTK_TRIANGLE
     geometry_blocks.push_back(std::move(points));
     geometry_blocks.push_back(std::move(connectivity));
@@ -444,7 +444,7 @@ SurfaceMesh read_vtu(const std::filesystem::path& file, VtuFields* fields, const
   for (const DataArray& a : arrays.in("PointData")) {
     const std::vector<double> values = arrays.values(a, n_points);
     if (a.components == 1 && a.name == "phi") {
-      for (auto v : mesh.vertices()) mesh.phi(v) = values[std::size_t(v.idx())];
+      io_detail::for_each_vertex(mesh, [&](VertexHandle v) { mesh.phi(v) = values[std::size_t(v.idx())]; });
     }
     if (!fields) continue;
     if (a.components == 1) {
