@@ -112,8 +112,9 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
       point_scalar(name, [&](VertexHandle v) { return values[std::size_t(v.idx())]; });
     }
   }
-  for (const auto& [name, values] : fields.point_vectors) {
-    Block b{fmt::format(R"(type="Float64" Name="{}" NumberOfComponents="3")", xml_escape(name)), {}};
+  for (const auto& field : fields.point_vectors) {
+    const auto& values = field.second;  // a variable, not a binding: lambdas capture it (clang 14)
+    Block b{fmt::format(R"(type="Float64" Name="{}" NumberOfComponents="3")", xml_escape(field.first)), {}};
     b.bytes.reserve(24 * n_points);
     io_detail::for_each_vertex(mesh, [&](VertexHandle v) { append_raw(b.bytes, values[std::size_t(v.idx())].data(), 3); });
     point_blocks.push_back(std::move(b));
@@ -132,8 +133,9 @@ void write_vtu(const SurfaceMesh& mesh, const std::filesystem::path& file, const
     cell_blocks.push_back(std::move(region));
     cell_blocks.push_back(std::move(quality));
   }
-  for (const auto& [name, values] : fields.cell_scalars) {
-    Block b{fmt::format(R"(type="Float64" Name="{}")", xml_escape(name)), {}};
+  for (const auto& field : fields.cell_scalars) {
+    const auto& values = field.second;  // a variable, not a binding: lambdas capture it (clang 14)
+    Block b{fmt::format(R"(type="Float64" Name="{}")", xml_escape(field.first)), {}};
     b.bytes.reserve(8 * n_cells);
     io_detail::for_each_face(mesh, [&](FaceHandle f) { append_raw(b.bytes, &values[std::size_t(f.idx())], 1); });
     cell_blocks.push_back(std::move(b));
